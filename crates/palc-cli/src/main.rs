@@ -1,0 +1,24 @@
+//! `palc`: the command line of palc, a thin layer over the library crates.
+//!
+//! Each subcommand lives in its own module under `commands/`; this file only
+//! parses arguments and dispatches.
+
+use clap::{Parser, Subcommand};
+
+mod commands;
+
+/// Personalized automated lane change that learns from the driver's takeovers.
+#[derive(Debug, Parser)]
+#[command(name = "palc", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {}
+
+fn main() -> anyhow::Result<()> {
+    let cli = Cli::parse();
+    match cli.command {}
+}
