@@ -1,7 +1,16 @@
 //! Project tasks for palc, run as `cargo xtask <task>` from anywhere in the
 //! workspace (the alias lives in `.cargo/config.toml`).
+//!
+//! Repository hygiene lives in `tidy.rs` as ordinary tests, run by
+//! `cargo test --workspace`.
+
+use std::path::{Path, PathBuf};
+
+#[cfg(test)]
+mod tidy;
 
 fn main() -> anyhow::Result<()> {
+    std::env::set_current_dir(project_root())?;
     let task = std::env::args().nth(1);
     match task.as_deref() {
         None | Some("help" | "--help" | "-h") => {
@@ -17,4 +26,12 @@ fn main() -> anyhow::Result<()> {
 
 fn print_help() {
     println!("cargo xtask <task>\n\ntasks:\n  help    this text");
+}
+
+/// The workspace root: the parent of this crate's manifest directory.
+fn project_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("xtask lives one level below the workspace root")
+        .to_path_buf()
 }

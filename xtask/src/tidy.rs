@@ -1,0 +1,116 @@
+//! Repository hygiene, checked as ordinary tests (`cargo test -p xtask`).
+//!
+//! Each test reads files of the workspace and names what is out of place, so
+//! that the documents stay true as the code changes.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use crate::project_root;
+
+fn read(path: &Path) -> String {
+    fs::read_to_string(path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()))
+}
+
+fn crate_dirs() -> Vec<PathBuf> {
+    let mut dirs: Vec<PathBuf> = fs::read_dir(project_root().join("crates"))
+        .expect("crates/ exists")
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|path| path.join("Cargo.toml").is_file())
+        .collect();
+    dirs.sort();
+    dirs
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            rust_files(&path, out);
+        } else if path.extension().is_some_and(|ext| ext == "rs") {
+            out.push(path);
+        }
+    }
+}
+
+/// The external crates of `[workspace.dependencies]` (those without a `path`).
+fn external_workspace_dependencies() -> Vec<String> {
+    let manifest = read(&project_root().join("Cargo.toml"));
+    let mut in_section = false;
+    let mut names = Vec::new();
+    for line in manifest.lines() {
+        let line = line.trim();
+        if line.starts_with('[') {
+            in_section = line == "[workspace.dependencies]";
+            continue;
+        }
+        if !in_section || line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        if let Some((name, spec)) = line.split_once('=') {
+            if !spec.contains("path =") {
+                names.push(name.trim().to_owned());
+            }
+        }
+    }
+    names
+}
+
+#[test]
+fn every_crate_has_a_section_in_the_architecture_document() {
+    let architecture = read(&project_root().join("docs/ARCHITECTURE.md"));
+    let missing: Vec<String> = crate_dirs()
+        .iter()
+        .map(|dir| format!("### `crates/{}`", dir.file_name().unwrap().to_string_lossy()))
+        .filter(|heading| !architecture.contains(heading.as_str()))
+        .collect();
+    assert!(missing.is_empty(), "docs/ARCHITECTURE.md lacks the sections {missing:?}");
+}
+
+#[test]
+fn every_dependency_is_explained_in_the_architecture_document() {
+    let architecture = read(&project_root().join("docs/ARCHITECTURE.md"));
+    let missing: Vec<String> = external_workspace_dependencies()
+        .into_iter()
+        .filter(|name| !architecture.contains(&format!("`{name}`")))
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "docs/ARCHITECTURE.md does not explain the dependencies {missing:?}"
+    );
+}
+
+#[test]
+fn every_crate_root_starts_with_an_overview() {
+    let mut roots: Vec<PathBuf> = crate_dirs()
+        .iter()
+        .flat_map(|dir| [dir.join("src/lib.rs"), dir.join("src/main.rs")])
+        .collect();
+    roots.push(project_root().join("xtask/src/main.rs"));
+    let missing: Vec<String> = roots
+        .iter()
+        .filter(|path| path.is_file() && !read(path).trim_start().starts_with("//!"))
+        .map(|path| path.display().to_string())
+        .collect();
+    assert!(missing.is_empty(), "crate roots without a `//!` overview: {missing:?}");
+}
+
+#[test]
+fn no_stubs_are_left_in_the_code() {
+    let mut files = Vec::new();
+    rust_files(&project_root().join("crates"), &mut files);
+    rust_files(&project_root().join("xtask"), &mut files);
+    let stubs = [concat!("todo", "!("), concat!("unimplemented", "!(")];
+    let offenders: Vec<String> = files
+        .iter()
+        .filter(|path| {
+            let text = read(path);
+            stubs.iter().any(|stub| text.contains(stub))
+        })
+        .map(|path| path.display().to_string())
+        .collect();
+    assert!(offenders.is_empty(), "stubs left in {offenders:?}");
+}
