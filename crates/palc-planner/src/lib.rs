@@ -1,4 +1,68 @@
 //! The lane-change trajectory planner: a linear time-varying model predictive
-//! controller solved as a convex quadratic program (paper Eqs. 9-23 and 34).
+//! controller solved as a sparse convex quadratic program (paper Eqs. 9-23 and 34).
+//!
+//! The state is `X = [s, v, l, φ]` and the control `U = [a, δ]`; the dynamics are the
+//! kinematic bicycle linearized around a reference speed profile and discretized by
+//! forward Euler (Eqs. 11-14, in the physically consistent order of the reading notes):
+//! `s' = v`, `v' = a`, `l' = v_ref φ`, `φ' = (v_ref / l_fr) δ - v_ref R`.
+//! The cost is `w · Φ(ψ)` of Eqs. (15) and (34), with the squared distances to the
+//! predicted preceding and adjacent vehicles, plus documented [`Extras`]: an
+//! acceleration penalty, an optional tracking term (the form of Eq. 25) and the
+//! slack penalty of soft lateral bounds.
+//!
+//! Main types: [`PlannerConfig`] (fixed between plans), [`Problem`] (one plan's input),
+//! [`Planner`] (caches the QP structure), [`Plan`] (trajectory, objective, features,
+//! statistics), [`Weights`] and [`Features`] (10 x K), [`features`] (the one feature map)
+//! and [`check_convexity`]. Every refusal is a [`PlanError`].
 //!
 //! This crate depends on no other palc crate: plain numbers in, results out.
+//! Pass `s` relative to the ego's position at the start of the plan (`initial.s = 0`)
+//! so that the `s δ` feature (w7) does not depend on where on the road the plan begins.
+//!
+//! ```
+//! use palc_planner::{
+//!     LateralBound, Planner, PlannerConfig, Position, Problem, State, Terminal, Weights,
+//! };
+//!
+//! let config = PlannerConfig { horizon: 40, dt: 0.1, ..PlannerConfig::default() };
+//! let k = config.horizon;
+//! let speed = 20.0;
+//! let problem = Problem {
+//!     initial: State { s: 0.0, v: speed, l: 0.0, phi: 0.0 },
+//!     reference_speed: vec![speed; k],
+//!     curvature: 0.0,
+//!     // w1 = 0.1 (stay near l = 0 unless pulled), w3 = 1, w8 = 10 (smooth steering).
+//!     weights: Weights::constant(k, [0.1, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 10.0, 0.0, 0.0]),
+//!     preceding: (0..k).map(|i| Position { s: 30.0 + 18.0 * 0.1 * i as f64, l: 0.0 }).collect(),
+//!     adjacent: (0..k).map(|i| Position { s: -20.0 + 22.0 * 0.1 * i as f64, l: 3.5 }).collect(),
+//!     terminal: Terminal { s: None, v: speed, l: 3.5 },
+//!     lateral_bounds: vec![Some(LateralBound::new(-1.75, 5.25)); k + 1],
+//!     tracking: None,
+//! };
+//! let mut planner = Planner::new(config)?;
+//! let plan = planner.plan(&problem)?;
+//! assert!((plan.states[k].l - 3.5).abs() < 1e-6);
+//! let w_phi = problem.weights.dot(&plan.features).unwrap();
+//! assert!((plan.objective - (w_phi + plan.extras.total())).abs() < 1e-6 * (1.0 + plan.objective.abs()));
+//! # Ok::<(), palc_planner::PlanError>(())
+//! ```
+#![warn(missing_docs)]
+
+mod clarabel_backend;
+mod config;
+mod convexity;
+mod error;
+mod features;
+mod planner;
+mod problem;
+mod qp;
+mod validate;
+mod weights;
+
+pub use config::{Backend, LateralBoundsMode, PlannerConfig, SolverSettings};
+pub use convexity::check_convexity;
+pub use error::{ConfigError, PlanError, StepRanges};
+pub use features::{features, stage_features};
+pub use planner::{Extras, Plan, Planner, SolveStats, SolveStatus};
+pub use problem::{Control, LateralBound, Position, Problem, State, Terminal, Tracking};
+pub use weights::{FEATURE_COUNT, Features, Weights, feature};

@@ -1,0 +1,144 @@
+//! The clarabel backend: keeps one solver per sparsity pattern and only overwrites
+//! values between plans.
+
+use clarabel::algebra::CscMatrix;
+use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
+
+use crate::qp::{CscPattern, Pattern, QpData};
+use crate::{PlanError, SolverSettings};
+
+/// Raw result of one solve.
+pub(crate) struct RawSolution {
+    pub status: SolverStatus,
+    pub iterations: u32,
+    pub x: Vec<f64>,
+    pub z: Vec<f64>,
+    pub reused: bool,
+    pub setup_seconds: f64,
+    pub solve_seconds: f64,
+}
+
+struct Cached {
+    pattern: Pattern,
+    p: CscPattern,
+    a: CscPattern,
+    solver: DefaultSolver<f64>,
+}
+
+/// A clarabel solver cached by sparsity pattern.
+#[derive(Default)]
+pub(crate) struct ClarabelBackend {
+    cached: Option<Cached>,
+    p_nz: Vec<f64>,
+    a_nz: Vec<f64>,
+}
+
+impl std::fmt::Debug for ClarabelBackend {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("ClarabelBackend")
+            .field("cached", &self.cached.is_some())
+            .finish()
+    }
+}
+
+fn settings(s: &SolverSettings) -> DefaultSettings<f64> {
+    DefaultSettings {
+        verbose: false,
+        max_iter: s.max_iter,
+        tol_gap_abs: s.tol_gap_abs,
+        tol_gap_rel: s.tol_gap_rel,
+        tol_feas: s.tol_feas,
+        equilibrate_enable: s.equilibrate_enable,
+        iterative_refinement_enable: s.iterative_refinement_enable,
+        // No bound is ever infinite, so presolve would find nothing to remove; off, it
+        // also guarantees that data updates are accepted.
+        presolve_enable: false,
+        input_sparse_dropzeros: false,
+        max_threads: 1,
+        direct_solve_method: "qdldl".to_string(),
+        ..DefaultSettings::default()
+    }
+}
+
+impl ClarabelBackend {
+    pub fn solve(
+        &mut self,
+        data: &QpData,
+        pattern: Pattern,
+        solver_settings: &SolverSettings,
+    ) -> Result<RawSolution, PlanError> {
+        let start = std::time::Instant::now();
+        let reusable = solver_settings.reuse_structure
+            && self
+                .cached
+                .as_ref()
+                .is_some_and(|c| c.pattern == pattern && c.solver.is_data_update_allowed());
+        let mut reused = false;
+        if reusable {
+            let cached = self.cached.as_mut().expect("checked above");
+            cached.p.scatter(&data.p_vals, &mut self.p_nz);
+            cached.a.scatter(&data.a_vals, &mut self.a_nz);
+            let updated = cached
+                .solver
+                .update_data(&self.p_nz, &data.q, &self.a_nz, &data.b);
+            reused = updated.is_ok();
+        }
+        if !reused {
+            let p = CscPattern::new(data.n, data.n, &data.p_rows, &data.p_cols);
+            let a = CscPattern::new(data.m_eq + data.m_in, data.n, &data.a_rows, &data.a_cols);
+            p.scatter(&data.p_vals, &mut self.p_nz);
+            a.scatter(&data.a_vals, &mut self.a_nz);
+            let p_mat = CscMatrix::new(
+                p.m,
+                p.n,
+                p.colptr.clone(),
+                p.rowval.clone(),
+                self.p_nz.clone(),
+            );
+            let a_mat = CscMatrix::new(
+                a.m,
+                a.n,
+                a.colptr.clone(),
+                a.rowval.clone(),
+                self.a_nz.clone(),
+            );
+            let cones = [
+                SupportedConeT::ZeroConeT(data.m_eq),
+                SupportedConeT::NonnegativeConeT(data.m_in),
+            ];
+            let solver = DefaultSolver::new(
+                &p_mat,
+                &data.q,
+                &a_mat,
+                &data.b,
+                &cones,
+                settings(solver_settings),
+            )
+            .map_err(|e| PlanError::SolverFailed {
+                status: format!("setup error: {e}"),
+                iterations: 0,
+            })?;
+            self.cached = Some(Cached {
+                pattern,
+                p,
+                a,
+                solver,
+            });
+        }
+        let setup_seconds = start.elapsed().as_secs_f64();
+        let cached = self.cached.as_mut().expect("set above");
+        let start = std::time::Instant::now();
+        cached.solver.solve();
+        let solve_seconds = start.elapsed().as_secs_f64();
+        let solution = &cached.solver.solution;
+        Ok(RawSolution {
+            status: solution.status,
+            iterations: solution.iterations,
+            x: solution.x.clone(),
+            z: solution.z.clone(),
+            reused,
+            setup_seconds,
+            solve_seconds,
+        })
+    }
+}

@@ -1,0 +1,190 @@
+//! Planner configuration: horizon, step, vehicle, extra cost terms and solver settings.
+
+use serde::{Deserialize, Serialize};
+
+use crate::ConfigError;
+
+/// How the lateral bounds of Eq. (22) enter the QP.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+#[non_exhaustive]
+pub enum LateralBoundsMode {
+    /// Hard constraints, as in the paper; inconsistent zones are refused as infeasible.
+    Hard,
+    /// Soft constraints: each bounded step gets one slack `σ_i >= 0` with
+    /// `l_min - σ_i <= l_i <= l_max + σ_i` and cost `weight · σ_i`, so the penalty is the
+    /// L1 distance of `l_i` to the zone. Learned zones are often mutually inconsistent and
+    /// a lane change must still be planned.
+    Soft {
+        /// Cost per metre of violation (per step); must be `> 0`.
+        weight: f64,
+    },
+}
+
+/// The QP backend. Only clarabel exists today; a Riccati-based interior-point
+/// backend can be added behind the same API.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum Backend {
+    /// The sparse interior-point solver of the `clarabel` crate.
+    #[default]
+    Clarabel,
+}
+
+/// Settings passed to the QP solver; the defaults were chosen by measurement
+/// (see the crate documentation and docs/paper-mapping.md).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SolverSettings {
+    /// Maximum interior-point iterations.
+    pub max_iter: u32,
+    /// Absolute duality-gap tolerance.
+    pub tol_gap_abs: f64,
+    /// Relative duality-gap tolerance.
+    pub tol_gap_rel: f64,
+    /// Primal and dual feasibility tolerance.
+    pub tol_feas: f64,
+    /// Ruiz equilibration of the problem data before the first solve.
+    pub equilibrate_enable: bool,
+    /// Iterative refinement of every KKT solve.
+    pub iterative_refinement_enable: bool,
+    /// Keep the solver (symbolic factorization, scaling) between plans with the same
+    /// sparsity pattern and only overwrite the values.
+    pub reuse_structure: bool,
+}
+
+impl Default for SolverSettings {
+    fn default() -> Self {
+        Self {
+            max_iter: 100,
+            tol_gap_abs: 1e-8,
+            tol_gap_rel: 1e-8,
+            tol_feas: 1e-8,
+            equilibrate_enable: true,
+            iterative_refinement_enable: true,
+            reuse_structure: true,
+        }
+    }
+}
+
+/// Everything about the planner that stays fixed between plans.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PlannerConfig {
+    /// Horizon `K` (number of stages); states are `X_0..X_K`.
+    pub horizon: usize,
+    /// Step `Δt` (s) of the forward-Euler discretization (Eqs. 12-14).
+    pub dt: f64,
+    /// Distance `l_fr` between the front and rear axles (m).
+    pub wheelbase: f64,
+    /// Weight `ρ_a` of the extra cost `ρ_a Σ a_i²` (m⁻² s⁴). The printed cost leaves the
+    /// acceleration free, which makes the optimum non-unique and, with `w9` or `w10`
+    /// non-zero, absurd; see docs/paper-mapping.md.
+    pub acceleration_penalty: f64,
+    /// Lowest front wheel angle `δ_min` (rad) of Eq. (23).
+    pub steering_min: f64,
+    /// Highest front wheel angle `δ_max` (rad) of Eq. (23).
+    pub steering_max: f64,
+    /// Hard (paper) or soft lateral bounds.
+    pub lateral_bounds_mode: LateralBoundsMode,
+    /// QP backend.
+    pub backend: Backend,
+    /// Solver settings.
+    pub solver: SolverSettings,
+}
+
+impl Default for PlannerConfig {
+    fn default() -> Self {
+        Self {
+            horizon: 60,
+            dt: 0.1,
+            wheelbase: 2.8,
+            acceleration_penalty: 1.0,
+            steering_min: -0.5,
+            steering_max: 0.5,
+            lateral_bounds_mode: LateralBoundsMode::Soft { weight: 100.0 },
+            backend: Backend::Clarabel,
+            solver: SolverSettings::default(),
+        }
+    }
+}
+
+impl PlannerConfig {
+    /// Checks every field; the error names the field, its value and the bound.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let check = |field: &'static str, value: f64, ok: bool, bound: &'static str| {
+            if ok {
+                Ok(())
+            } else {
+                Err(ConfigError::OutOfRange {
+                    field,
+                    value,
+                    bound,
+                })
+            }
+        };
+        if self.horizon == 0 {
+            return Err(ConfigError::OutOfRange {
+                field: "horizon",
+                value: 0.0,
+                bound: "at least 1",
+            });
+        }
+        let positive = "finite and > 0";
+        check(
+            "dt",
+            self.dt,
+            self.dt.is_finite() && self.dt > 0.0,
+            positive,
+        )?;
+        check(
+            "wheelbase",
+            self.wheelbase,
+            self.wheelbase.is_finite() && self.wheelbase > 0.0,
+            positive,
+        )?;
+        check(
+            "acceleration_penalty",
+            self.acceleration_penalty,
+            self.acceleration_penalty.is_finite() && self.acceleration_penalty >= 0.0,
+            "finite and >= 0",
+        )?;
+        check(
+            "steering_min",
+            self.steering_min,
+            self.steering_min.is_finite(),
+            "finite",
+        )?;
+        check(
+            "steering_max",
+            self.steering_max,
+            self.steering_max.is_finite() && self.steering_max >= self.steering_min,
+            "finite and >= steering_min",
+        )?;
+        if let LateralBoundsMode::Soft { weight } = self.lateral_bounds_mode {
+            check(
+                "lateral_bounds_mode.soft.weight",
+                weight,
+                weight.is_finite() && weight > 0.0,
+                positive,
+            )?;
+        }
+        let s = &self.solver;
+        if s.max_iter == 0 {
+            return Err(ConfigError::OutOfRange {
+                field: "solver.max_iter",
+                value: 0.0,
+                bound: "at least 1",
+            });
+        }
+        for (field, value) in [
+            ("solver.tol_gap_abs", s.tol_gap_abs),
+            ("solver.tol_gap_rel", s.tol_gap_rel),
+            ("solver.tol_feas", s.tol_feas),
+        ] {
+            check(field, value, value.is_finite() && value > 0.0, positive)?;
+        }
+        Ok(())
+    }
+}

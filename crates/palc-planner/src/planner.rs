@@ -1,0 +1,235 @@
+//! The planner: validation, QP assembly, solve, and the plan with its features.
+
+use clarabel::solver::SolverStatus;
+use serde::{Deserialize, Serialize};
+
+use crate::clarabel_backend::ClarabelBackend;
+use crate::qp::{QpData, RowTag, control_index, pattern_of, state_index};
+use crate::validate::validate_problem;
+use crate::{
+    Backend, Control, Features, LateralBoundsMode, PlanError, PlannerConfig, Problem, State,
+    StepRanges, features,
+};
+
+/// The extra cost terms added to `w · Φ` (documented in docs/paper-mapping.md).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct Extras {
+    /// `ρ_a Σ_{i=0}^{K-1} a_i²`.
+    pub acceleration: f64,
+    /// `Σ_i (X_i - X_i^ref)ᵀ Q^p (X_i - X_i^ref)` over the steps with a reference.
+    pub tracking: f64,
+    /// `ρ_soft Σ_i σ_i` (soft lateral bounds only).
+    pub lateral_slack: f64,
+}
+
+impl Extras {
+    /// Sum of the extra terms.
+    pub fn total(&self) -> f64 {
+        self.acceleration + self.tracking + self.lateral_slack
+    }
+}
+
+/// How the solver finished.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+#[non_exhaustive]
+pub enum SolveStatus {
+    /// Solved to the requested tolerances.
+    Solved,
+    /// Solved to clarabel's reduced tolerances only.
+    AlmostSolved,
+}
+
+/// Statistics of one plan.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SolveStats {
+    /// Solver status.
+    pub status: SolveStatus,
+    /// Interior-point iterations.
+    pub iterations: u32,
+    /// Wall time to validate, assemble and set up (or update) the QP (s).
+    pub build_seconds: f64,
+    /// Wall time of the solve itself (s).
+    pub solve_seconds: f64,
+    /// Whether the cached solver structure was reused (values overwritten only).
+    pub structure_reused: bool,
+}
+
+/// An optimal lane-change trajectory.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Plan {
+    /// `X_0..X_K`.
+    pub states: Vec<State>,
+    /// `U_0..U_{K-1}`.
+    pub controls: Vec<Control>,
+    /// The optimal value of the whole objective, `w · Φ(ψ) + extras`, including the
+    /// constants of the squared distances and of the tracking term.
+    pub objective: f64,
+    /// The learned part `w · Φ(ψ)` (Eq. 15).
+    pub learned_cost: f64,
+    /// The extra terms.
+    pub extras: Extras,
+    /// `Φ(ψ)` of Eq. (34) for this trajectory.
+    pub features: Features,
+    /// Soft-bound violation `σ_i` per step `0..=K` (0 where there is no slack).
+    pub lateral_violation: Vec<f64>,
+    /// Solver statistics.
+    pub stats: SolveStats,
+}
+
+/// The lane-change planner (Eqs. 9-23). Reuses its QP structure between plans with the
+/// same sparsity pattern.
+#[derive(Debug)]
+pub struct Planner {
+    config: PlannerConfig,
+    data: QpData,
+    clarabel: ClarabelBackend,
+}
+
+impl Planner {
+    /// A planner for a validated configuration.
+    pub fn new(config: PlannerConfig) -> Result<Self, PlanError> {
+        config.validate()?;
+        let Backend::Clarabel = config.backend;
+        Ok(Self {
+            config,
+            data: QpData::default(),
+            clarabel: ClarabelBackend::default(),
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &PlannerConfig {
+        &self.config
+    }
+
+    /// Plans one lane change: minimizes `w · Φ(ψ) + extras` subject to the dynamics,
+    /// the boundary conditions and the bounds.
+    pub fn plan(&mut self, problem: &Problem) -> Result<Plan, PlanError> {
+        let start = std::time::Instant::now();
+        validate_problem(&self.config, problem)?;
+        self.data.assemble(&self.config, problem);
+        let assembled = start.elapsed().as_secs_f64();
+        let raw = self
+            .clarabel
+            .solve(&self.data, pattern_of(problem), &self.config.solver)?;
+        let status = match raw.status {
+            SolverStatus::Solved => SolveStatus::Solved,
+            SolverStatus::AlmostSolved => SolveStatus::AlmostSolved,
+            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
+                return Err(self.infeasible(&raw.z));
+            }
+            SolverStatus::DualInfeasible | SolverStatus::AlmostDualInfeasible => {
+                return Err(PlanError::Unbounded);
+            }
+            other => {
+                return Err(PlanError::SolverFailed {
+                    status: format!("{other:?}"),
+                    iterations: raw.iterations,
+                });
+            }
+        };
+        let k = self.config.horizon;
+        let x = &raw.x;
+        let states: Vec<State> = (0..=k)
+            .map(|i| {
+                let o = state_index(i);
+                State::from_array([x[o], x[o + 1], x[o + 2], x[o + 3]])
+            })
+            .collect();
+        let controls: Vec<Control> = (0..k)
+            .map(|i| {
+                let o = control_index(i);
+                Control {
+                    a: x[o],
+                    delta: x[o + 1],
+                }
+            })
+            .collect();
+        let lateral_violation: Vec<f64> = self
+            .data
+            .slack_of_step
+            .iter()
+            .map(|s| s.map_or(0.0, |j| x[j]))
+            .collect();
+        let features = features(&states, &controls, &problem.preceding, &problem.adjacent)?;
+        let learned_cost = problem
+            .weights
+            .dot(&features)
+            .expect("weights and features share the horizon");
+        let extras = self.extras(problem, &states, &controls, &lateral_violation);
+        Ok(Plan {
+            objective: self.data.objective(x),
+            states,
+            controls,
+            learned_cost,
+            extras,
+            features,
+            lateral_violation,
+            stats: SolveStats {
+                status,
+                iterations: raw.iterations,
+                build_seconds: assembled + raw.setup_seconds,
+                solve_seconds: raw.solve_seconds,
+                structure_reused: raw.reused,
+            },
+        })
+    }
+
+    fn extras(
+        &self,
+        problem: &Problem,
+        states: &[State],
+        controls: &[Control],
+        violation: &[f64],
+    ) -> Extras {
+        let acceleration =
+            self.config.acceleration_penalty * controls.iter().map(|u| u.a * u.a).sum::<f64>();
+        let tracking = problem.tracking.as_ref().map_or(0.0, |t| {
+            states
+                .iter()
+                .zip(&t.reference)
+                .filter_map(|(x, r)| r.map(|r| (x.to_array(), r.to_array())))
+                .map(|(x, r)| {
+                    (0..4)
+                        .map(|c| t.weights[c] * (x[c] - r[c]).powi(2))
+                        .sum::<f64>()
+                })
+                .sum()
+        });
+        let lateral_slack = match self.config.lateral_bounds_mode {
+            LateralBoundsMode::Soft { weight } => weight * violation.iter().sum::<f64>(),
+            LateralBoundsMode::Hard => 0.0,
+        };
+        Extras {
+            acceleration,
+            tracking,
+            lateral_slack,
+        }
+    }
+
+    /// Reads the steps that carry clarabel's primal infeasibility certificate.
+    fn infeasible(&self, z: &[f64]) -> PlanError {
+        let m_eq = self.data.m_eq;
+        let scale = z.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
+        let threshold = 1e-6 * scale;
+        let mut lateral = Vec::new();
+        let mut steering = Vec::new();
+        for (tag, &zi) in self.data.row_tags.iter().zip(&z[m_eq..]) {
+            if zi.abs() <= threshold {
+                continue;
+            }
+            match *tag {
+                RowTag::Lateral(i) => lateral.push(i),
+                RowTag::Steering(i) => steering.push(i),
+                RowTag::Slack => {}
+            }
+        }
+        lateral.dedup();
+        steering.dedup();
+        PlanError::Infeasible {
+            lateral_steps: StepRanges::from_steps(lateral),
+            steering_steps: StepRanges::from_steps(steering),
+        }
+    }
+}
