@@ -1,7 +1,56 @@
-//! Road, vehicles and Intelligent Driver Model (IDM) background traffic for
-//! personalized automated lane change (PALC).
+//! Road, vehicles and Intelligent Driver Model (IDM) background traffic for personalized
+//! automated lane change (PALC).
 //!
-//! This crate will hold the paper's test bed (Section III.A): a two-lane road in
-//! Frenet coordinates, vehicles following the IDM, the scenario grid of speed
-//! cases and adjacent headways, and predictions of the surrounding vehicles over
-//! a planning horizon.
+//! This crate holds the paper's test bed (Section III.A): a two-lane road in Frenet
+//! coordinates ([`Road`]), vehicles following the IDM ([`IdmParams`], integrated by the
+//! ballistic [`ballistic_step`]), the grid of speed cases, adjacent headways and seeds
+//! ([`TestbedCell`]), a [`Scene`] that advances with the ego's state supplied from outside,
+//! and predictions of the preceding and adjacent vehicles over a planning horizon
+//! ([`Scene::predict`]) that the zone filter and the planner consume as plain numbers.
+//!
+//! Everything inside is SI; the paper's mph appear only in configs ([`ScenarioConfig`]).
+//!
+//! ```
+//! use palc_traffic::{EgoState, PredictionModel, Scene, ScenarioConfig};
+//!
+//! let config = ScenarioConfig::from_toml_str(r#"
+//!     [testbed]
+//!     speed_cases = [{ name = "collector-high", ego_mph = 45.0, others_mph = 40.0 }]
+//!     adjacent_headways_m = [40.0]
+//!     seeds = [7]
+//! "#)?;
+//! let mut scene = Scene::from_config(&config, 0)?;
+//! let ego = scene.ego().unwrap().state;
+//! // The harness drives the ego; here it keeps its lane at constant speed for one step.
+//! let dt = 0.1;
+//! scene.step(dt, EgoState { s: ego.s + ego.v * dt, l: ego.l, v: ego.v, heading: 0.0 })?;
+//! let prediction = scene.predict(40, dt, PredictionModel::ConstantSpeed)?;
+//! assert_eq!(prediction.adjacent.len(), 41);
+//! assert!(prediction.adjacent[0][1] > 3.0); // the adjacent vehicle is on the target lane
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+#![warn(missing_docs)]
+
+mod config;
+mod error;
+mod idm;
+mod platoon;
+mod prediction;
+mod road;
+mod scene;
+mod testbed;
+pub mod units;
+mod vehicle;
+
+pub use config::{
+    IdmConfig, MAX_SPEED_MPH, PlatoonConfig, ProfilePointConfig, RoadConfig, ScenarioConfig,
+    SpeedCaseConfig, TestbedConfig, VehicleConfig,
+};
+pub use error::{ConfigError, SceneError};
+pub use idm::{BallisticStep, IdmParams, MIN_INTERACTION_GAP, ballistic_step};
+pub use prediction::{MAX_HORIZON_STEPS, Prediction, PredictionModel};
+pub use road::{Lane, Road};
+pub use scene::{MAX_DT, MAX_VEHICLES, Scene};
+pub use testbed::{PAPER_ADJACENT_HEADWAYS, SpeedCase, TestbedCell};
+pub use vehicle::{Driver, EgoState, SpeedProfile, Vehicle, VehicleId, VehicleState};

@@ -1,0 +1,322 @@
+//! Scenario configs as read from TOML.
+//!
+//! Every field name carries its unit (`_m`, `_s`, `_mph`, `_mps2`); a field in another unit
+//! is an unknown field and is refused (`deny_unknown_fields`). Speeds are given in mph, as in
+//! the paper, and converted to SI when a scene is built.
+
+use crate::error::ConfigError;
+use crate::idm::IdmParams;
+use crate::road::Road;
+use serde::{Deserialize, Serialize};
+
+/// Largest plausible road speed in a config (mph); bigger values are most likely km/h.
+pub const MAX_SPEED_MPH: f64 = 100.0;
+
+/// A whole scenario config: road, vehicles, IDM and exactly one of `testbed` or `platoon`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScenarioConfig {
+    /// The road section.
+    #[serde(default)]
+    pub road: RoadConfig,
+    /// Vehicle dimensions, shared by all vehicles.
+    #[serde(default)]
+    pub vehicle: VehicleConfig,
+    /// IDM parameters of the background vehicles (the desired speed comes from the scenario).
+    #[serde(default)]
+    pub idm: IdmConfig,
+    /// The paper's test bed and its grid of cells.
+    pub testbed: Option<TestbedConfig>,
+    /// A platoon on one lane behind a scripted leader.
+    pub platoon: Option<PlatoonConfig>,
+}
+
+/// `[road]`: the road section.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RoadConfig {
+    /// Length of the section where vehicles are placed at the start (m); the paper's 200 m.
+    pub length_m: f64,
+    /// Lane width (m); the paper's 3.5 m.
+    pub lane_width_m: f64,
+    /// Number of lanes.
+    pub lanes: u32,
+}
+
+impl Default for RoadConfig {
+    fn default() -> Self {
+        RoadConfig {
+            length_m: 200.0,
+            lane_width_m: 3.5,
+            lanes: 2,
+        }
+    }
+}
+
+/// `[vehicle]`: dimensions of every vehicle.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct VehicleConfig {
+    /// Length (m); 5 m as in Treiber et al. (2000).
+    pub length_m: f64,
+    /// Width (m), used by the lateral occupancy rule.
+    pub width_m: f64,
+}
+
+impl Default for VehicleConfig {
+    fn default() -> Self {
+        VehicleConfig {
+            length_m: 5.0,
+            width_m: 1.8,
+        }
+    }
+}
+
+/// `[idm]`: IDM parameters except the desired speed, with Treiber et al. (2000) as defaults.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct IdmConfig {
+    /// T, desired time gap (s).
+    pub t_s: f64,
+    /// s0, minimum net gap (m).
+    pub s0_m: f64,
+    /// a, maximum acceleration (m/s^2).
+    pub a_mps2: f64,
+    /// b, comfortable deceleration (m/s^2), positive.
+    pub b_mps2: f64,
+    /// delta, acceleration exponent.
+    pub delta: f64,
+    /// Physical braking limit that clips the IDM's deceleration (m/s^2), positive.
+    pub max_braking_mps2: f64,
+    /// Test bed only: desired speed of target-lane followers as a multiple of the background
+    /// speed, above 1 so that a finite gap can hold the background speed.
+    pub desired_speed_ratio: f64,
+}
+
+impl Default for IdmConfig {
+    fn default() -> Self {
+        let p = IdmParams::treiber_2000(1.0);
+        IdmConfig {
+            t_s: p.t,
+            s0_m: p.s0,
+            a_mps2: p.a,
+            b_mps2: p.b,
+            delta: p.delta,
+            max_braking_mps2: 9.0,
+            desired_speed_ratio: 1.2,
+        }
+    }
+}
+
+impl IdmConfig {
+    /// The IDM parameters with desired speed `v0` (m/s).
+    pub fn params(&self, v0: f64) -> IdmParams {
+        IdmParams {
+            v0,
+            t: self.t_s,
+            s0: self.s0_m,
+            a: self.a_mps2,
+            b: self.b_mps2,
+            delta: self.delta,
+        }
+    }
+}
+
+/// `[testbed]`: the paper's test bed (Section III.A) and its grid of cells.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TestbedConfig {
+    /// Front position of the ego at the start (m).
+    #[serde(default = "default_ego_start")]
+    pub ego_start_s_m: f64,
+    /// Initial time headway of the ego to the preceding vehicle, front to front over the ego speed (s).
+    #[serde(default = "default_initial_time_headway")]
+    pub initial_time_headway_s: f64,
+    /// Range of the adjacent vehicle's initial lead over the ego, as a fraction of the adjacent
+    /// headway, `[min, max]` within `[0, 1]`; the seed draws the value.
+    #[serde(default = "default_adjacent_phase")]
+    pub adjacent_phase: [f64; 2],
+    /// Half-width of the uniform jitter added to every background vehicle's initial position (m).
+    #[serde(default = "default_jitter")]
+    pub position_jitter_m: f64,
+    /// Front-to-front headway of a background vehicle behind the ego on lane 0 (m); none if absent.
+    pub follower_headway_m: Option<f64>,
+    /// The speed cases (paper: 45/40, 45/35, 65/60, 65/55 mph).
+    pub speed_cases: Vec<SpeedCaseConfig>,
+    /// Front-to-front headways on the target lane (m) (paper: 50, 45, 40, 35, 30).
+    pub adjacent_headways_m: Vec<f64>,
+    /// Seeds; each cell of the grid is one (speed case, headway, seed).
+    pub seeds: Vec<u64>,
+}
+
+fn default_ego_start() -> f64 {
+    40.0
+}
+fn default_initial_time_headway() -> f64 {
+    3.0
+}
+fn default_adjacent_phase() -> [f64; 2] {
+    [0.2, 0.8]
+}
+fn default_jitter() -> f64 {
+    0.5
+}
+
+/// One speed case of the test bed, in mph as in the paper.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpeedCaseConfig {
+    /// Name used in reports, e.g. `collector-high`.
+    pub name: String,
+    /// Ego speed (mph).
+    pub ego_mph: f64,
+    /// Speed of the surrounding vehicles (mph).
+    pub others_mph: f64,
+}
+
+/// `[platoon]`: vehicles on one lane behind a scripted leader, the usual way to compare IDM
+/// implementations.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlatoonConfig {
+    /// Number of vehicles including the leader.
+    pub vehicles: u32,
+    /// Lane of the platoon.
+    #[serde(default)]
+    pub lane: u32,
+    /// Front position of the leader at the start (m).
+    pub leader_start_s_m: f64,
+    /// Front-to-front headway between consecutive vehicles at the start (m).
+    pub headway_m: f64,
+    /// Initial speed of the followers (mph); the leader starts at its profile's speed.
+    pub initial_speed_mph: f64,
+    /// IDM desired speed v0 of the followers (mph).
+    pub desired_speed_mph: f64,
+    /// The leader's speed profile: piecewise linear between points, constant outside.
+    pub leader_profile: Vec<ProfilePointConfig>,
+}
+
+/// One point of a scripted speed profile.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ProfilePointConfig {
+    /// Time (s).
+    pub time_s: f64,
+    /// Speed (mph).
+    pub speed_mph: f64,
+}
+
+impl ScenarioConfig {
+    /// Parses a TOML config and validates the parts that do not depend on a grid cell.
+    pub fn from_toml_str(text: &str) -> Result<ScenarioConfig, ConfigError> {
+        let config: ScenarioConfig = toml::from_str(text)?;
+        config.validate()?;
+        Ok(config)
+    }
+
+    /// Checks the road, vehicle and IDM tables and that exactly one scenario is given.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        self.road()?;
+        positive("vehicle.length_m", self.vehicle.length_m)?;
+        positive("vehicle.width_m", self.vehicle.width_m)?;
+        let idm = &self.idm;
+        positive("idm.t_s", idm.t_s)?;
+        non_negative("idm.s0_m", idm.s0_m)?;
+        positive("idm.a_mps2", idm.a_mps2)?;
+        positive("idm.b_mps2", idm.b_mps2)?;
+        positive("idm.delta", idm.delta)?;
+        in_range(
+            "idm.max_braking_mps2",
+            idm.max_braking_mps2,
+            idm.b_mps2,
+            f64::INFINITY,
+            "at least idm.b_mps2",
+        )?;
+        if !(idm.desired_speed_ratio > 1.0 && idm.desired_speed_ratio.is_finite()) {
+            return Err(out_of_range(
+                "idm.desired_speed_ratio",
+                idm.desired_speed_ratio,
+                "above 1",
+            ));
+        }
+        match (&self.testbed, &self.platoon) {
+            (None, None) => Err(ConfigError::ScenarioKind { found: "neither" }),
+            (Some(_), Some(_)) => Err(ConfigError::ScenarioKind { found: "both" }),
+            _ => Ok(()),
+        }
+    }
+
+    /// The road of this config, validated.
+    pub fn road(&self) -> Result<Road, ConfigError> {
+        let r = &self.road;
+        positive("road.length_m", r.length_m)?;
+        positive("road.lane_width_m", r.lane_width_m)?;
+        if r.lanes == 0 {
+            return Err(out_of_range("road.lanes", 0.0, "at least 1"));
+        }
+        Ok(Road {
+            length: r.length_m,
+            lane_width: r.lane_width_m,
+            lanes: r.lanes,
+        })
+    }
+}
+
+pub(crate) fn out_of_range(field: &str, value: f64, bound: &str) -> ConfigError {
+    ConfigError::OutOfRange {
+        field: field.to_owned(),
+        value,
+        bound: bound.to_owned(),
+    }
+}
+
+/// Finite and strictly positive.
+pub(crate) fn positive(field: &str, value: f64) -> Result<f64, ConfigError> {
+    in_range(
+        field,
+        value,
+        f64::MIN_POSITIVE,
+        f64::MAX,
+        "finite and above 0",
+    )
+}
+
+/// Finite and not negative.
+pub(crate) fn non_negative(field: &str, value: f64) -> Result<f64, ConfigError> {
+    in_range(field, value, 0.0, f64::MAX, "finite and at least 0")
+}
+
+/// Within `[min, max]` and not NaN; `bound` describes the range for the message.
+pub(crate) fn in_range(
+    field: &str,
+    value: f64,
+    min: f64,
+    max: f64,
+    bound: &str,
+) -> Result<f64, ConfigError> {
+    if value >= min && value <= max {
+        Ok(value)
+    } else {
+        Err(out_of_range(field, value, bound))
+    }
+}
+
+/// A speed in mph within `(0, MAX_SPEED_MPH]`, or within `[0, ..]` when `allow_zero`.
+pub(crate) fn speed_mph(field: &str, value: f64, allow_zero: bool) -> Result<f64, ConfigError> {
+    let ok = value <= MAX_SPEED_MPH
+        && if allow_zero {
+            value >= 0.0
+        } else {
+            value > 0.0
+        };
+    if ok {
+        Ok(value)
+    } else {
+        let lower = if allow_zero { "[0" } else { "(0" };
+        Err(out_of_range(
+            field,
+            value,
+            &format!("in {lower}, {MAX_SPEED_MPH}] mph (a larger value may be in km/h)"),
+        ))
+    }
+}
