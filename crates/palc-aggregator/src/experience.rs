@@ -1,0 +1,245 @@
+//! The experience store: what was learned, versioned, saved without ever losing data.
+
+use std::fs;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use palc_planner::Weights;
+use palc_zone_filter::ZoneModel;
+use serde::{Deserialize, Serialize};
+
+use crate::{AggregatorError, ApprenticeshipState, resample_weights};
+
+/// The experience format version this build writes and the newest it reads.
+pub const EXPERIENCE_FORMAT_VERSION: u32 = 1;
+
+/// Who and what an experience belongs to.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExperienceMetadata {
+    /// The user the experience personalizes to.
+    pub user_id: String,
+    /// The scenario it was learned in (free text, e.g. `45-40mph-40m`).
+    pub scenario: String,
+    /// The method that learned it (free text, e.g. `palc` or `paper`).
+    pub method: String,
+    /// Lessons (takeovers) learned from so far.
+    pub lessons: u64,
+    /// Step `Δt` (s) of the weight matrix's columns.
+    pub dt: f64,
+}
+
+/// What has been learned: the zone model with its statistics, the 10 x K weight
+/// matrix, the apprenticeship state and metadata.
+///
+/// Saved as JSON `{format_version, metadata, weights, zone, apprenticeship}`; the
+/// zone is the zone filter's own versioned serialization. Numbers round-trip
+/// bit-exactly (shortest representation on write, correctly rounded parse).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Experience {
+    /// Who and what.
+    pub metadata: ExperienceMetadata,
+    /// The learned weights; column `c` weighs the stage at time `c · dt` after the
+    /// start of the plan.
+    pub weights: Weights,
+    /// The zone model, once the zone is used.
+    pub zone: Option<ZoneModel>,
+    /// The apprenticeship rule's projection point, once that rule has run.
+    pub apprenticeship: Option<ApprenticeshipState>,
+}
+
+/// The file layout: the version first, so that a reader sees it before anything else.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Stored {
+    format_version: u32,
+    metadata: ExperienceMetadata,
+    weights: Weights,
+    zone: Option<ZoneModel>,
+    apprenticeship: Option<ApprenticeshipState>,
+}
+
+#[derive(Deserialize)]
+struct VersionProbe {
+    format_version: u32,
+}
+
+impl Experience {
+    /// A fresh experience: no lesson yet, the given (standard) weights, no zone.
+    ///
+    /// # Errors
+    /// [`AggregatorError::Resample`] for `dt` not finite and positive or an empty
+    /// weight matrix, [`AggregatorError::NonFinite`] for a non-finite weight.
+    pub fn new(
+        user_id: impl Into<String>,
+        scenario: impl Into<String>,
+        method: impl Into<String>,
+        weights: Weights,
+        dt: f64,
+    ) -> Result<Self, AggregatorError> {
+        let experience = Experience {
+            metadata: ExperienceMetadata {
+                user_id: user_id.into(),
+                scenario: scenario.into(),
+                method: method.into(),
+                lessons: 0,
+                dt,
+            },
+            weights,
+            zone: None,
+            apprenticeship: None,
+        };
+        experience.validate()?;
+        Ok(experience)
+    }
+
+    /// The weights for a plan of `horizon` steps of `dt`, resampled by the rule of
+    /// [`resample_weights`] (time since the start of the plan, linear interpolation,
+    /// last column held).
+    pub fn weights_for(&self, horizon: usize, dt: f64) -> Result<Weights, AggregatorError> {
+        resample_weights(&self.weights, self.metadata.dt, horizon, dt)
+    }
+
+    /// Checks the invariants a stored experience must satisfy.
+    pub fn validate(&self) -> Result<(), AggregatorError> {
+        let dt = self.metadata.dt;
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(AggregatorError::Resample {
+                reason: format!("metadata.dt = {dt} s must be finite and > 0"),
+            });
+        }
+        if self.weights.horizon() == 0 {
+            return Err(AggregatorError::Resample {
+                reason: "the weight matrix has no column".into(),
+            });
+        }
+        let matrices = std::iter::once(("weights", self.weights.columns())).chain(
+            self.apprenticeship
+                .as_ref()
+                .map(|a| ("apprenticeship.mu_bar", a.mu_bar.columns())),
+        );
+        for (name, columns) in matrices {
+            for (c, column) in columns.iter().enumerate() {
+                for (j, &x) in column.iter().enumerate() {
+                    if !x.is_finite() {
+                        return Err(AggregatorError::NonFinite {
+                            field: format!("{name}[{c}][{j}]"),
+                            value: x,
+                        });
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Writes the experience to `path` without ever losing data: to a temporary file
+    /// in the same directory first, flushed to disk (`fsync`), then renamed over
+    /// `path` (atomic on POSIX file systems), then the directory is synced. On any
+    /// error the previous file at `path` is left as it was.
+    ///
+    /// # Errors
+    /// [`AggregatorError::NonFinite`] (JSON has no NaN), [`AggregatorError::Io`].
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), AggregatorError> {
+        let path = path.as_ref();
+        self.validate()?;
+        let stored = Stored {
+            format_version: EXPERIENCE_FORMAT_VERSION,
+            metadata: self.metadata.clone(),
+            weights: self.weights.clone(),
+            zone: self.zone.clone(),
+            apprenticeship: self.apprenticeship.clone(),
+        };
+        let mut bytes =
+            serde_json::to_vec_pretty(&stored).map_err(|e| AggregatorError::Serialize {
+                reason: e.to_string(),
+            })?;
+        bytes.push(b'\n');
+        let io = |source| AggregatorError::Io {
+            path: path.to_path_buf(),
+            source,
+        };
+        let file_name = path.file_name().ok_or_else(|| {
+            io(std::io::Error::new(
+                std::io::ErrorKind::InvalidInput,
+                "the path names no file",
+            ))
+        })?;
+        let directory = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let mut temporary_name = std::ffi::OsString::from(".");
+        temporary_name.push(file_name);
+        temporary_name.push(format!(".tmp-{}", std::process::id()));
+        let temporary = directory.join(temporary_name);
+        let write = || -> std::io::Result<()> {
+            let mut file = fs::File::create(&temporary)?;
+            file.write_all(&bytes)?;
+            file.sync_all()?;
+            drop(file);
+            fs::rename(&temporary, path)?;
+            sync_directory(&directory)
+        };
+        write().map_err(|e| {
+            let _ = fs::remove_file(&temporary);
+            io(e)
+        })
+    }
+
+    /// Reads an experience written by [`Experience::save`]. Nothing is modified.
+    ///
+    /// # Errors
+    /// [`AggregatorError::Io`] if the file cannot be read,
+    /// [`AggregatorError::UnsupportedVersion`] for a file from a newer format version,
+    /// [`AggregatorError::Corrupt`] for anything that does not parse or validate
+    /// (truncated, edited, a zone model the zone filter refuses).
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, AggregatorError> {
+        let path = path.as_ref();
+        let bytes = fs::read(path).map_err(|source| AggregatorError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_json(&bytes, path)
+    }
+
+    /// Parses the bytes of an experience file; `path` only names it in errors.
+    fn from_json(bytes: &[u8], path: &Path) -> Result<Self, AggregatorError> {
+        let corrupt = |reason: String| AggregatorError::Corrupt {
+            path: path.to_path_buf(),
+            reason,
+        };
+        let probe: VersionProbe =
+            serde_json::from_slice(bytes).map_err(|e| corrupt(e.to_string()))?;
+        if probe.format_version > EXPERIENCE_FORMAT_VERSION {
+            return Err(AggregatorError::UnsupportedVersion {
+                path: path.to_path_buf(),
+                found: probe.format_version,
+                supported: EXPERIENCE_FORMAT_VERSION,
+            });
+        }
+        if probe.format_version == 0 {
+            return Err(corrupt("format_version 0 does not exist".into()));
+        }
+        let stored: Stored = serde_json::from_slice(bytes).map_err(|e| corrupt(e.to_string()))?;
+        let experience = Experience {
+            metadata: stored.metadata,
+            weights: stored.weights,
+            zone: stored.zone,
+            apprenticeship: stored.apprenticeship,
+        };
+        experience.validate().map_err(|e| corrupt(e.to_string()))?;
+        Ok(experience)
+    }
+}
+
+#[cfg(unix)]
+fn sync_directory(directory: &Path) -> std::io::Result<()> {
+    fs::File::open(directory)?.sync_all()
+}
+
+#[cfg(not(unix))]
+fn sync_directory(_directory: &Path) -> std::io::Result<()> {
+    Ok(())
+}

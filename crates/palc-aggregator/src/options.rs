@@ -1,0 +1,71 @@
+//! The options of one learning step.
+
+use palc_zone_filter::{BoundsConfig, ZoneConfig};
+use serde::{Deserialize, Serialize};
+
+use crate::{
+    AggregatorError, ApprenticeshipRule, ConvexSet, CorrectionRule, ExpertKind, FeatureScale,
+    LearnableRows, ZoneCentreExpert,
+};
+
+/// How the aggregator learns from a lesson. Maps one to one onto a TOML table.
+///
+/// The defaults are the repaired method that personalized 60 / 60 grid cases in an
+/// independent prototype: the lesson expert, the incremental rule on rows `w1`, `w2`,
+/// no zone (a zone on top personalized only 35 / 60 there; it has to earn its place
+/// by measurement). [`AggregatorOptions::paper`] gives the paper's method.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct AggregatorOptions {
+    /// Expert trajectory generator.
+    pub expert: ExpertKind,
+    /// Reward correction rule.
+    pub correction: CorrectionRule,
+    /// Rows the correction may change.
+    pub learnable_rows: LearnableRows,
+    /// Per-row feature scale of the correction.
+    pub feature_scale: FeatureScale,
+    /// The convex set the weights are kept in.
+    pub convex_set: ConvexSet,
+    /// Learn the perceived safe zone and bound the plans by it (Eqs. 1-8, 22, 27-32).
+    /// Default `false`.
+    pub use_zone: bool,
+    /// Configuration of a new zone model, when the experience has none yet.
+    pub zone: ZoneConfig,
+    /// How the zone is projected onto lateral bounds.
+    pub bounds: BoundsConfig,
+}
+
+impl AggregatorOptions {
+    /// The paper's method: zone-centre expert (Eqs. 24-26), apprenticeship learning
+    /// (Eqs. 33-36) on all ten rows, zone on (scaled features and the convex set stay,
+    /// since the printed method is unbounded and non-convex without them).
+    pub fn paper() -> Self {
+        AggregatorOptions {
+            expert: ExpertKind::ZoneCentre(ZoneCentreExpert::default()),
+            correction: CorrectionRule::Apprenticeship(ApprenticeshipRule::default()),
+            learnable_rows: LearnableRows::ALL,
+            use_zone: true,
+            ..AggregatorOptions::default()
+        }
+    }
+
+    /// Checks every option and their combination.
+    pub fn validate(&self) -> Result<(), AggregatorError> {
+        self.feature_scale.validate()?;
+        self.convex_set.validate()?;
+        if let CorrectionRule::Incremental(rule) = &self.correction {
+            rule.validate()?;
+        }
+        if matches!(self.expert, ExpertKind::ZoneCentre(_)) && !self.use_zone {
+            return Err(AggregatorError::ConflictingOptions {
+                reason: "the zone_centre expert needs the zone: set use_zone = true or use the lesson expert",
+            });
+        }
+        if self.use_zone {
+            self.zone.validate()?;
+            self.bounds.validate()?;
+        }
+        Ok(())
+    }
+}
