@@ -1,2 +1,39 @@
 //! Simulated users and the lesson-learning loop (paper Section II.A and Fig. 2):
 //! plan, execute in traffic, let the user take over, learn, repeat.
+//!
+//! The loop ties the other crates together: [`palc_traffic`] moves the background
+//! traffic, [`palc_planner`] plans each lane change, the user of [`user`] judges
+//! it step by step, and on a takeover [`palc_aggregator`] (with
+//! [`palc_zone_filter`]) learns from the lesson. Two methods run side by side
+//! ([`Method`]): the paper's, with only its equation errors corrected, and palc's.
+//!
+//! ```no_run
+//! use palc_harness::{LearnConfig, NoObserver, run};
+//!
+//! let text = std::fs::read_to_string("configs/learn.toml")?;
+//! let config = LearnConfig::from_toml_str(&text)?;
+//! let result = run(&config, None, &mut NoObserver)?;
+//! println!("{:?} after {} takeovers", result.summary.outcome, result.summary.takeovers);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+#![warn(missing_docs)]
+#![warn(clippy::print_stdout, clippy::print_stderr)]
+
+mod config;
+mod drive;
+mod error;
+mod learn;
+mod method;
+mod record;
+mod setup;
+mod standard_alc;
+pub mod user;
+
+pub use config::{CellChoice, LearnConfig, StoppingConfig, UserConfig};
+pub use drive::{Drive, execute, problem};
+pub use error::HarnessError;
+pub use learn::{NoObserver, Observer, PRESET_STYLES, RunResult, aggregator_options, prepare, run};
+pub use method::{Driver, Method, label};
+pub use record::{LaneChangeRecord, Outcome, PartTimes, RunSummary, Takeover};
+pub use setup::{PlanningConfig, Setup};
+pub use standard_alc::StandardWeights;

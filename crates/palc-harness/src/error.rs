@@ -1,0 +1,51 @@
+//! Errors of the harness.
+
+use thiserror::Error;
+
+/// What can go wrong while setting up or running the lesson-learning loop.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum HarnessError {
+    /// A config value is out of its bound.
+    #[error("invalid config: `{field}` is {value}, expected {bound}")]
+    InvalidConfig {
+        /// Dotted path of the field.
+        field: String,
+        /// The value found.
+        value: f64,
+        /// The bound it violates.
+        bound: String,
+    },
+    /// A style name that is none of the presets.
+    #[error("unknown driving style `{0}`: expected `aggressive`, `neutral` or `cautious`")]
+    UnknownStyle(String),
+    /// A speed case that the scenario config does not define.
+    #[error("unknown speed case `{0}`: the scenario config defines {1}")]
+    UnknownSpeedCase(String, String),
+    /// The scenario does not fit the planning set-up (e.g. a user who never starts).
+    #[error("scenario {scenario}: {reason}")]
+    Scenario {
+        /// Which grid cell.
+        scenario: String,
+        /// What does not hold.
+        reason: String,
+    },
+    /// The TOML config could not be read.
+    #[error("cannot parse the config: {0}")]
+    Toml(#[from] toml::de::Error),
+    /// An error of the traffic simulation.
+    #[error(transparent)]
+    Traffic(#[from] palc_traffic::SceneError),
+    /// An error of the traffic config.
+    #[error(transparent)]
+    TrafficConfig(#[from] palc_traffic::ConfigError),
+    /// An error of the planner.
+    #[error(transparent)]
+    Planner(#[from] palc_planner::PlanError),
+    /// An error of the zone filter.
+    #[error(transparent)]
+    Zone(#[from] palc_zone_filter::ZoneError),
+    /// An error of the aggregator.
+    #[error(transparent)]
+    Aggregator(#[from] palc_aggregator::AggregatorError),
+}

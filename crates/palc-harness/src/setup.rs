@@ -1,0 +1,308 @@
+//! The planning set-up of one scenario: when planning starts, how far it looks
+//! ahead, what the surrounding vehicles are predicted to do, and when each user
+//! would start.
+//!
+//! Planning starts at a trigger earlier than any user (a time headway to the
+//! preceding vehicle larger than every style's), so that the planner decides
+//! when to move laterally with its time-indexed weights (NOTES.md, "Let the
+//! planner decide when to move"). The horizon covers the standard ALC's end plus
+//! a margin, so that no user's lane change ends after the terminal condition pins
+//! the lateral position.
+
+use palc_traffic::{EgoState, Lane, Scene};
+use serde::{Deserialize, Serialize};
+
+use crate::HarnessError;
+use crate::user::{ExpectedLaneChange, Situation, Style};
+
+/// Parameters of the planning set-up; defaults in `configs/learn.toml`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PlanningConfig {
+    /// Step of the plan and of the simulation (s).
+    pub dt: f64,
+    /// Time headway to the preceding vehicle at which planning starts (s); must be
+    /// larger than every user's, so that planning starts before any user would.
+    pub trigger_time_headway_s: f64,
+    /// Time after the standard ALC's end that the horizon still covers (s).
+    pub horizon_margin_s: f64,
+    /// Longest approach before the trigger (s); a scenario that never triggers is refused.
+    pub max_approach_s: f64,
+    /// How far after the trigger users' starts are searched (s).
+    pub search_window_s: f64,
+    /// The standard ALC before learning: conservative, later and slower than every style.
+    pub standard_alc: Style,
+    /// Lateral position of the target lane's centre (m).
+    pub target_l: f64,
+    /// Deviation beyond which the user takes over (m); the paper's 0.3 m.
+    pub takeover_threshold_m: f64,
+}
+
+impl Default for PlanningConfig {
+    fn default() -> Self {
+        Self {
+            dt: 0.1,
+            trigger_time_headway_s: 2.2,
+            horizon_margin_s: 1.0,
+            max_approach_s: 60.0,
+            search_window_s: 30.0,
+            standard_alc: Style {
+                time_headway_s: 1.0,
+                lane_change_duration_s: 3.5,
+                min_lead_gap_s: 1.0,
+            },
+            target_l: 3.5,
+            takeover_threshold_m: 0.3,
+        }
+    }
+}
+
+impl PlanningConfig {
+    /// Checks every field against its bound.
+    pub fn validate(&self) -> Result<(), HarnessError> {
+        let positive = [
+            ("planning.dt", self.dt),
+            ("planning.trigger_time_headway_s", self.trigger_time_headway_s),
+            ("planning.max_approach_s", self.max_approach_s),
+            ("planning.search_window_s", self.search_window_s),
+            ("planning.takeover_threshold_m", self.takeover_threshold_m),
+        ];
+        for (field, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(invalid(field, value, "a finite value > 0"));
+            }
+        }
+        if !(self.dt <= 0.5) {
+            return Err(invalid("planning.dt", self.dt, "at most 0.5 s"));
+        }
+        if !(self.horizon_margin_s.is_finite() && self.horizon_margin_s >= 0.0) {
+            return Err(invalid(
+                "planning.horizon_margin_s",
+                self.horizon_margin_s,
+                "a finite value >= 0",
+            ));
+        }
+        if !self.target_l.is_finite() {
+            return Err(invalid("planning.target_l", self.target_l, "finite"));
+        }
+        self.standard_alc.validate("planning.standard_alc")
+    }
+}
+
+fn invalid(field: &str, value: f64, bound: &str) -> HarnessError {
+    HarnessError::InvalidConfig {
+        field: field.to_owned(),
+        value,
+        bound: bound.to_owned(),
+    }
+}
+
+/// Everything the loop needs about one scenario, computed once at the trigger.
+#[derive(Debug, Clone)]
+pub struct Setup {
+    /// The scene at the trigger; every lane change starts from a clone of it.
+    pub scene: Scene,
+    /// Time from the scene's start to the trigger (s).
+    pub trigger_time_s: f64,
+    /// Planning horizon K.
+    pub horizon: usize,
+    /// Step (s).
+    pub dt: f64,
+    /// Ego speed, held through the lane change (m/s).
+    pub ego_speed: f64,
+    /// Ego longitudinal position at the trigger (m); plans use `s` relative to it.
+    pub origin_s: f64,
+    /// What a user sees at each step `0..` of the search window, the ego keeping its lane.
+    pub situations: Vec<Situation>,
+    /// Predicted preceding vehicle `(s − origin_s, l)` at steps `0..=K`.
+    pub preceding: Vec<[f64; 2]>,
+    /// Predicted adjacent vehicle `(s − origin_s, l)` at steps `0..=K`.
+    pub adjacent: Vec<[f64; 2]>,
+    /// Start step of the standard ALC.
+    pub standard_start_step: usize,
+    /// Lateral position of the target lane's centre (m).
+    pub target_l: f64,
+}
+
+impl Setup {
+    /// Drives the ego at constant speed in its lane until the trigger, then predicts
+    /// the scene over the search window.
+    pub fn new(scene: &Scene, config: &PlanningConfig, label: &str) -> Result<Setup, HarnessError> {
+        config.validate()?;
+        let scenario_error = |reason: String| HarnessError::Scenario {
+            scenario: label.to_owned(),
+            reason,
+        };
+        let ego = scene
+            .ego()
+            .ok_or_else(|| scenario_error("the scene has no ego vehicle".to_owned()))?;
+        let ego_speed = ego.state.v;
+        if !(ego_speed > 0.0) {
+            return Err(scenario_error(format!("the ego speed is {ego_speed} m/s, expected > 0")));
+        }
+        if scene.preceding().is_none() {
+            return Err(scenario_error("the scene has no preceding vehicle".to_owned()));
+        }
+
+        let mut scene = scene.clone();
+        let approach_steps = (config.max_approach_s / config.dt).ceil() as usize;
+        let mut trigger = None;
+        for step in 0..=approach_steps {
+            if situation(&scene).time_headway_s <= config.trigger_time_headway_s {
+                trigger = Some(step);
+                break;
+            }
+            lane_keeping_step(&mut scene, config.dt)?;
+        }
+        if trigger.is_none() {
+            return Err(scenario_error(format!(
+                "the time headway never falls to the trigger {} s within {} s",
+                config.trigger_time_headway_s, config.max_approach_s
+            )));
+        }
+        let trigger_time_s = scene.time();
+        let origin_s = scene.ego().map_or(0.0, |e| e.state.s);
+
+        let window = (config.search_window_s / config.dt).ceil() as usize;
+        let mut rollout = scene.clone();
+        let mut situations = Vec::with_capacity(window + 1);
+        let mut preceding = Vec::with_capacity(window + 1);
+        let mut adjacent = Vec::with_capacity(window + 1);
+        for step in 0..=window {
+            situations.push(situation(&rollout));
+            preceding.push(relative(rollout.preceding().map(|v| (v.state.s, v.state.l)), origin_s));
+            adjacent.push(relative(rollout.adjacent().map(|v| (v.state.s, v.state.l)), origin_s));
+            if step < window {
+                lane_keeping_step(&mut rollout, config.dt)?;
+            }
+        }
+
+        let standard = &config.standard_alc;
+        let standard_start_step = standard.start_step(&situations).ok_or_else(|| {
+            scenario_error(format!(
+                "the standard ALC never starts within the {} s search window",
+                config.search_window_s
+            ))
+        })?;
+        let end_s = standard_start_step as f64 * config.dt
+            + standard.lane_change_duration_s
+            + config.horizon_margin_s;
+        let horizon = (end_s / config.dt).ceil() as usize;
+        if horizon > window {
+            return Err(scenario_error(format!(
+                "the horizon ({horizon} steps) exceeds the search window ({window} steps)"
+            )));
+        }
+        preceding.truncate(horizon + 1);
+        adjacent.truncate(horizon + 1);
+        Ok(Setup {
+            scene,
+            trigger_time_s,
+            horizon,
+            dt: config.dt,
+            ego_speed,
+            origin_s,
+            situations,
+            preceding,
+            adjacent,
+            standard_start_step,
+            target_l: config.target_l,
+        })
+    }
+
+    /// The lane change a user of `style` expects in this scenario, or `None` when
+    /// the user would not start within the horizon.
+    pub fn expected(&self, style: &Style) -> Option<ExpectedLaneChange> {
+        let start = style.start_step(&self.situations[..=self.horizon])?;
+        let expected = ExpectedLaneChange {
+            start_s: start as f64 * self.dt,
+            duration_s: style.lane_change_duration_s,
+            from_l: 0.0,
+            to_l: self.target_l,
+        };
+        (expected.end_s() <= self.horizon as f64 * self.dt + 1e-9).then_some(expected)
+    }
+
+    /// The standard ALC's own lane change in this scenario.
+    pub fn standard_lane_change(&self, standard: &Style) -> ExpectedLaneChange {
+        ExpectedLaneChange {
+            start_s: self.standard_start_step as f64 * self.dt,
+            duration_s: standard.lane_change_duration_s,
+            from_l: 0.0,
+            to_l: self.target_l,
+        }
+    }
+
+    /// Checks the paper's premise in this scenario: the standard ALC starts later and
+    /// moves slower than each style. Returns what does not hold, naming the style.
+    pub fn check_conservative(
+        &self,
+        standard: &Style,
+        styles: &[(&str, Style)],
+    ) -> Result<(), String> {
+        let standard_start = self.standard_start_step as f64 * self.dt;
+        for (name, style) in styles {
+            let Some(expected) = self.expected(style) else {
+                return Err(format!("the {name} user does not change lanes within the horizon"));
+            };
+            if expected.start_s >= standard_start {
+                return Err(format!(
+                    "the standard ALC starts at {standard_start:.2} s, not later than the {name} user ({:.2} s)",
+                    expected.start_s
+                ));
+            }
+            if style.lane_change_duration_s >= standard.lane_change_duration_s {
+                return Err(format!(
+                    "the standard ALC's lane change ({} s) is not slower than the {name} user's ({} s)",
+                    standard.lane_change_duration_s, style.lane_change_duration_s
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// One simulation step with the ego at constant speed in its lane.
+fn lane_keeping_step(scene: &mut Scene, dt: f64) -> Result<(), HarnessError> {
+    let ego = scene.ego().map(|e| e.state).unwrap_or_default();
+    let next = EgoState {
+        s: ego.s + ego.v * dt,
+        l: ego.l,
+        v: ego.v,
+        heading: 0.0,
+    };
+    scene.step(dt, next)?;
+    Ok(())
+}
+
+/// What a user sees in the scene: headway to the preceding vehicle, net gap to the
+/// nearest vehicle ahead on the target lane.
+fn situation(scene: &Scene) -> Situation {
+    let ego = scene.ego().map(|e| e.state).unwrap_or_default();
+    let ego_speed = ego.v.max(1e-6);
+    let headway_gap = scene
+        .preceding()
+        .map_or(f64::INFINITY, |p| p.rear() - ego.s);
+    let ego_rear = scene.ego().map_or(ego.s, |e| e.rear());
+    let target_lane = scene.vehicles().iter().filter(|v| v.lane == Lane(1));
+    let target_lead_gap_m = target_lane
+        .clone()
+        .filter(|v| v.state.s > ego.s)
+        .map(|v| v.rear() - ego.s)
+        .min_by(f64::total_cmp);
+    let target_lag_gap_m = target_lane
+        .filter(|v| v.state.s <= ego.s)
+        .map(|v| ego_rear - v.state.s)
+        .min_by(f64::total_cmp);
+    Situation {
+        time_headway_s: headway_gap / ego_speed,
+        target_lead_gap_m,
+        target_lag_gap_m,
+        ego_speed,
+    }
+}
+
+fn relative(position: Option<(f64, f64)>, origin_s: f64) -> [f64; 2] {
+    // A missing vehicle is placed far ahead on its lane, where it affects nothing.
+    position.map_or([1e4, 0.0], |(s, l)| [s - origin_s, l])
+}
