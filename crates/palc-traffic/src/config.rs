@@ -150,7 +150,7 @@ pub struct TestbedConfig {
 }
 
 fn default_ego_start() -> f64 {
-    40.0
+    50.0
 }
 fn default_initial_time_headway() -> f64 {
     3.0

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 pub struct VehicleId(pub u32);
 
 /// Kinematic state of a vehicle in Frenet coordinates; `s` is the position of its front bumper.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct VehicleState {
     /// Longitudinal position of the front bumper (m).
     pub s: f64,
@@ -24,7 +24,7 @@ pub struct VehicleState {
 }
 
 /// State of the ego supplied from outside at every step (the planner or the harness drives it).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct EgoState {
     /// Longitudinal position of the front bumper (m).
     pub s: f64,
