@@ -12,8 +12,9 @@ pub enum LateralBoundsMode {
     /// Hard constraints, as in the paper; inconsistent zones are refused as infeasible.
     Hard,
     /// Soft constraints: each bounded step gets one slack `σ_i >= 0` with
-    /// `l_min - σ_i <= l_i <= l_max + σ_i` and cost `weight · σ_i`, so the penalty is the
-    /// L1 distance of `l_i` to the zone. Learned zones are often mutually inconsistent and
+    /// `l_min - σ_i <= l_i <= l_max + σ_i` and cost `weight · σ_i`, so the penalty is
+    /// `weight · max(l_min - l_i, l_i - l_max, 0)`: the L1 distance of `l_i` to the zone
+    /// (for an empty zone, the larger of the two violations). Learned zones are often mutually inconsistent and
     /// a lane change must still be planned.
     Soft {
         /// Cost per metre of violation (per step); must be `> 0`.
