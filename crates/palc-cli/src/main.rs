@@ -16,9 +16,14 @@ struct Cli {
 }
 
 #[derive(Debug, Subcommand)]
-enum Command {}
+enum Command {
+    /// The perceived safe zone filter: fit on labelled samples, classify points.
+    Zone(commands::zone::ZoneArgs),
+}
 
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
-    match cli.command {}
+    match cli.command {
+        Command::Zone(args) => commands::zone::run(args),
+    }
 }

@@ -1,1 +1,3 @@
 //! One module per `palc` subcommand.
+
+pub mod zone;
