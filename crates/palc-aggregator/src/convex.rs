@@ -5,9 +5,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::{AggregatorError, LearnableRows};
 
-/// Relative margin kept in the Schur complement: couplings are shrunk until
+/// Relative margin kept in the Schur complement: a column with
+/// `Σ c_j² / d_j > (1 - SCHUR_MARGIN / 2) w8` has its couplings shrunk until
 /// `Σ c_j² / d_j <= (1 - SCHUR_MARGIN) w8`, so that rounding in any later check of the
-/// same block cannot turn it indefinite.
+/// same block cannot turn it indefinite, and projecting twice changes nothing.
 pub const SCHUR_MARGIN: f64 = 1e-9;
 
 /// A state diagonal at or below this fraction of the block's largest entry counts
@@ -124,6 +125,9 @@ fn project_column(w: &mut [f64; FEATURE_COUNT], epsilon: f64, learnable: &Learna
         }
     }
     let budget = (1.0 - SCHUR_MARGIN) * r;
+    // A column already shrunk to the budget must stay as it is (idempotence), so
+    // only a column beyond half the margin is moved.
+    let allowed = (1.0 - 0.5 * SCHUR_MARGIN) * r;
     let free = rows.map(|row| learnable.contains(row));
     let used_by = |couplings: &[f64; 3], pick: bool| -> f64 {
         (0..3)
@@ -131,7 +135,7 @@ fn project_column(w: &mut [f64; FEATURE_COUNT], epsilon: f64, learnable: &Learna
             .map(|j| couplings[j] * couplings[j] / diagonals[j])
             .sum()
     };
-    if used_by(&couplings, true) + used_by(&couplings, false) > budget {
+    if used_by(&couplings, true) + used_by(&couplings, false) > allowed {
         let fixed = used_by(&couplings, false);
         if fixed < budget {
             shrink_onto_ellipsoid(&mut couplings, &diagonals, &free, budget - fixed);

@@ -18,7 +18,12 @@ use crate::AggregatorError;
 /// prototype (NOTES.md, "Experience transfer").
 ///
 /// Every new column is a convex combination of old columns, so weights in the convex
-/// set of [`crate::ConvexSet`] stay in it.
+/// set of [`crate::ConvexSet`] stay in it mathematically. A numerical check with a
+/// tolerance relative to each block's largest entry (as `palc_planner::check_convexity`
+/// has) may still refuse an interpolated column whose tiny diagonal (e.g. `w3 = ε`)
+/// sits next to a coupling that was admissible in one of the two old columns; so
+/// [`crate::learn_from_lesson`] and [`crate::plan_problem`] project resampled weights
+/// with [`crate::project_convex`] before planning, and so should any other caller.
 ///
 /// # Errors
 /// [`AggregatorError::Resample`] for an empty matrix, `horizon == 0`, or a step that

@@ -1,0 +1,242 @@
+//! The experience store: bit-exact round trips, and files that are corrupt,
+//! truncated or from a newer version.
+
+mod common;
+
+use std::fs;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use palc_aggregator::{
+    AggregatorError, ApprenticeshipState, EXPERIENCE_FORMAT_VERSION, Experience,
+};
+use palc_planner::{FEATURE_COUNT, Features, Weights};
+use palc_zone_filter::{Label, Sample, ZoneConfig, ZoneModel};
+use proptest::prelude::*;
+
+/// A fresh directory under the system's temporary directory, one per call.
+fn scratch() -> PathBuf {
+    static NEXT: AtomicUsize = AtomicUsize::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "palc-aggregator-test-{}-{}",
+        std::process::id(),
+        NEXT.fetch_add(1, Ordering::Relaxed)
+    ));
+    let _ = fs::remove_dir_all(&dir);
+    fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn sample_experience() -> Experience {
+    let mut experience = Experience::new(
+        "user-7",
+        "45-40mph-40m",
+        "palc",
+        Weights::constant(20, common::STANDARD),
+        0.1,
+    )
+    .unwrap();
+    let samples: Vec<Sample> = (0..12)
+        .map(|i| {
+            let l = 0.3 * i as f64;
+            let x = vec![30.0 - l, -l, 30.0, 10.0, 3.5 - l, 10.6 + 0.01 * i as f64];
+            Sample::new(x, if i < 6 { Label::Safe } else { Label::Unsafe })
+        })
+        .collect();
+    experience.zone = Some(ZoneModel::fit(ZoneConfig::default(), &samples).unwrap());
+    experience.apprenticeship = Some(ApprenticeshipState {
+        mu_bar: Features::constant(20, [0.1; FEATURE_COUNT]),
+        updates: 3,
+    });
+    experience.metadata.lessons = 3;
+    experience
+}
+
+fn bits(w: &Weights) -> Vec<u64> {
+    w.columns().iter().flatten().map(|x| x.to_bits()).collect()
+}
+
+/// Any finite `f64`, including subnormals, -0.0 and extreme exponents.
+fn finite() -> impl Strategy<Value = f64> {
+    any::<f64>().prop_filter("finite", |x| x.is_finite())
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(64))]
+
+    #[test]
+    fn save_then_load_is_bit_exact(
+        columns in prop::collection::vec(prop::array::uniform10(finite()), 1..40),
+        mu in prop::collection::vec(prop::array::uniform10(finite()), 1..5),
+        dt in 1e-4f64..1.0,
+        lessons in any::<u64>(),
+        user in "[a-zA-Z0-9 _\\-\u{e9}\u{4e2d}]{0,16}",
+        with_zone in any::<bool>(),
+    ) {
+        let mut experience = Experience::new(user, "scene \"quoted\"", "palc", Weights::from_columns(columns), dt).unwrap();
+        experience.metadata.lessons = lessons;
+        experience.apprenticeship = Some(ApprenticeshipState { mu_bar: Features::from_columns(mu), updates: lessons });
+        if with_zone {
+            experience.zone = sample_experience().zone;
+        }
+        let dir = scratch();
+        let path = dir.join("experience.json");
+        experience.save(&path).unwrap();
+        let loaded = Experience::load(&path).unwrap();
+        prop_assert_eq!(bits(&loaded.weights), bits(&experience.weights));
+        prop_assert_eq!(loaded.metadata.dt.to_bits(), experience.metadata.dt.to_bits());
+        prop_assert_eq!(&loaded, &experience);
+        // Saving the loaded experience writes the same bytes.
+        let again = dir.join("again.json");
+        loaded.save(&again).unwrap();
+        prop_assert_eq!(fs::read(&path).unwrap(), fs::read(&again).unwrap());
+        fs::remove_dir_all(&dir).unwrap();
+    }
+}
+
+#[test]
+fn save_replaces_the_file_and_leaves_no_temporary_file() {
+    let dir = scratch();
+    let path = dir.join("experience.json");
+    let mut experience = sample_experience();
+    experience.save(&path).unwrap();
+    experience.metadata.lessons = 4;
+    experience.save(&path).unwrap();
+    assert_eq!(Experience::load(&path).unwrap().metadata.lessons, 4);
+    let names: Vec<_> = fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names, vec![std::ffi::OsString::from("experience.json")]);
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn failed_save_leaves_the_previous_file_in_place() {
+    let dir = scratch();
+    let path = dir.join("experience.json");
+    let experience = sample_experience();
+    experience.save(&path).unwrap();
+    let before = fs::read(&path).unwrap();
+    // A non-finite weight cannot be written as JSON: refused before touching the disk.
+    let mut bad = experience.clone();
+    bad.weights.columns_mut()[3][1] = f64::INFINITY;
+    let err = bad.save(&path).unwrap_err();
+    assert!(err.to_string().contains("weights[3][1]"), "{err}");
+    assert_eq!(fs::read(&path).unwrap(), before);
+    // A path that names a directory: the rename fails, nothing is lost.
+    let err = experience.save(&dir).unwrap_err();
+    assert!(matches!(err, AggregatorError::Io { .. }), "{err}");
+    assert_eq!(fs::read(&path).unwrap(), before);
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn truncated_file_is_a_clear_error_and_is_left_in_place() {
+    let dir = scratch();
+    let path = dir.join("experience.json");
+    sample_experience().save(&path).unwrap();
+    let full = fs::read(&path).unwrap();
+    for cut in [1, full.len() / 3, full.len() / 2, full.len() - 3] {
+        fs::write(&path, &full[..cut]).unwrap();
+        let err = Experience::load(&path).unwrap_err();
+        assert!(matches!(err, AggregatorError::Corrupt { .. }), "{err}");
+        let message = err.to_string();
+        assert!(message.contains("corrupt or truncated"), "{message}");
+        assert!(message.contains("experience.json"), "{message}");
+        assert_eq!(fs::read(&path).unwrap(), &full[..cut]);
+    }
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn corrupt_files_are_clear_errors() {
+    let dir = scratch();
+    let path = dir.join("experience.json");
+    sample_experience().save(&path).unwrap();
+    let text = fs::read_to_string(&path).unwrap();
+    let cases = [
+        ("not json", "garbage".to_owned()),
+        ("binary", "\u{0}\u{1}\u{2}".to_owned()),
+        ("no version", text.replace("\"format_version\": 1,", "")),
+        (
+            "unknown field",
+            text.replacen("\"metadata\": {", "\"extra\": 1, \"metadata\": {", 1),
+        ),
+        (
+            "wrong type",
+            text.replacen("\"lessons\": 3", "\"lessons\": \"three\"", 1),
+        ),
+        (
+            "negative dt",
+            text.replacen("\"dt\": 0.1", "\"dt\": -0.1", 1),
+        ),
+        (
+            "version 0",
+            text.replacen("\"format_version\": 1", "\"format_version\": 0", 1),
+        ),
+        (
+            "short column",
+            text.replacen("[\n      0.1,\n      0.0,", "[\n      0.1,", 1),
+        ),
+    ];
+    for (what, contents) in cases {
+        assert_ne!(contents, text, "{what}: the edit did not apply");
+        fs::write(&path, &contents).unwrap();
+        let err = Experience::load(&path).unwrap_err();
+        assert!(
+            matches!(err, AggregatorError::Corrupt { .. }),
+            "{what}: {err}"
+        );
+    }
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn newer_version_is_refused_naming_both_versions() {
+    let dir = scratch();
+    let path = dir.join("experience.json");
+    sample_experience().save(&path).unwrap();
+    let text = fs::read_to_string(&path).unwrap();
+    // A newer format may change everything else too: only the version is read.
+    let newer = text
+        .replacen("\"format_version\": 1", "\"format_version\": 7", 1)
+        .replacen("\"metadata\"", "\"meta_v7\"", 1);
+    fs::write(&path, newer).unwrap();
+    let err = Experience::load(&path).unwrap_err();
+    match &err {
+        AggregatorError::UnsupportedVersion {
+            found, supported, ..
+        } => {
+            assert_eq!(*found, 7);
+            assert_eq!(*supported, EXPERIENCE_FORMAT_VERSION);
+        }
+        other => panic!("expected UnsupportedVersion, got {other}"),
+    }
+    let message = err.to_string();
+    assert!(message.contains("format version 7"), "{message}");
+    assert!(
+        message.contains(&format!("up to {EXPERIENCE_FORMAT_VERSION}")),
+        "{message}"
+    );
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn missing_file_is_an_io_error_naming_it() {
+    let dir = scratch();
+    let err = Experience::load(dir.join("absent.json")).unwrap_err();
+    assert!(matches!(err, AggregatorError::Io { .. }), "{err}");
+    assert!(err.to_string().contains("absent.json"), "{err}");
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn weights_are_usable_at_another_horizon_and_step() {
+    let experience = sample_experience(); // K = 20 at 0.1 s
+    let w = experience.weights_for(40, 0.05).unwrap();
+    assert_eq!(w.horizon(), 40);
+    assert!(palc_planner::check_convexity(&w).is_ok());
+    assert!(experience.weights_for(0, 0.05).is_err());
+    assert!(experience.weights_for(10, 0.0).is_err());
+}
