@@ -5,7 +5,10 @@
 use palc_harness::{LearnConfig, Method, NoObserver, run};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let text = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../configs/learn.toml"))?;
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../configs/learn.toml"
+    ))?;
     let mut config = LearnConfig::from_toml_str(&text)?;
     let args: Vec<String> = std::env::args().collect();
     if args.len() > 2 {
@@ -21,7 +24,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     let takeovers: Vec<String> = result
                         .records
                         .iter()
-                        .map(|r| r.takeover.map_or("-".to_owned(), |t| format!("{:.1}", t.time_s)))
+                        .map(|r| {
+                            r.takeover
+                                .map_or("-".to_owned(), |t| format!("{:.1}", t.time_s))
+                        })
                         .collect();
                     println!(
                         "{:5} {:10} K={} {:?} takeovers={} final_dev={:.3} [{}]",

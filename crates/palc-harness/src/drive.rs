@@ -29,7 +29,11 @@ pub fn problem(setup: &Setup, weights: Weights, bounds: Vec<Option<LateralBound>
             v: setup.ego_speed,
             l: setup.target_l,
         },
-        lateral_bounds: if bounds.is_empty() { vec![None; k + 1] } else { bounds },
+        lateral_bounds: if bounds.is_empty() {
+            vec![None; k + 1]
+        } else {
+            bounds
+        },
         tracking: None,
     }
 }
@@ -128,7 +132,9 @@ pub fn execute(
             // The lane change ends where the driven path settles on the target lane,
             // and never before the step after the takeover, so that a takeover
             // always gives a ratio below 1.
-            let end = lane_change_end(&driven, setup.target_l).max(t.step + 1).min(k);
+            let end = lane_change_end(&driven, setup.target_l)
+                .max(t.step + 1)
+                .min(k);
             let whole = driven[end].s;
             if whole > 0.0 {
                 (t.distance_m / whole).clamp(0.0, 1.0)

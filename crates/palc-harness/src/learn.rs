@@ -13,13 +13,13 @@ use palc_traffic::Scene;
 use palc_zone_filter::{FeatureInput, Label, Sample, StepScene, features};
 use serde::{Deserialize, Serialize};
 
+use crate::HarnessError;
 use crate::config::LearnConfig;
 use crate::drive::{Drive, execute, problem};
 use crate::method::{Driver, Method, label};
 use crate::record::{LaneChangeRecord, Outcome, PartTimes, RunSummary};
 use crate::setup::Setup;
 use crate::user::{Style, User, first_takeover};
-use crate::HarnessError;
 
 /// Watches the loop; every method has a default that does nothing.
 pub trait Observer {
@@ -63,25 +63,25 @@ pub const PRESET_STYLES: [(&str, Style); 3] = [
 
 /// The aggregator options of a config: its own table if given, else the method's.
 pub fn aggregator_options(config: &LearnConfig) -> AggregatorOptions {
-    config.aggregator.clone().unwrap_or_else(|| match config.method {
-        Method::Paper => AggregatorOptions::paper(),
-        Method::Palc => AggregatorOptions::default(),
-    })
+    config
+        .aggregator
+        .clone()
+        .unwrap_or_else(|| match config.method {
+            Method::Paper => AggregatorOptions::paper(),
+            Method::Palc => AggregatorOptions::default(),
+        })
 }
 
 /// Builds the scenario of a config and checks the paper's premise in it: the
-/// standard ALC is later and slower than each of the paper's styles (and the
-/// configured user). The error names the scenario and what does not hold.
+/// standard ALC is later and slower than each of the paper's styles. The error
+/// names the scenario and what does not hold.
 pub fn prepare(config: &LearnConfig) -> Result<Setup, HarnessError> {
     config.validate()?;
     let label = config.label();
     let scene = Scene::for_cell(&config.traffic, &config.cell()?)?;
     let setup = Setup::new(&scene, &config.planning, &label)?;
-    let mut styles = PRESET_STYLES.to_vec();
-    let user = config.user.style()?;
-    styles.push(("configured", user));
     setup
-        .check_conservative(&config.planning.standard_alc, &styles)
+        .check_conservative(&config.planning.standard_alc, &PRESET_STYLES)
         .map_err(|reason| HarnessError::Scenario {
             scenario: label,
             reason,
@@ -134,10 +134,12 @@ pub fn run(
         Some(spread) => User::with_spread(nominal, spread)?,
         None => User::deterministic(nominal)?,
     };
-    let nominal_expected = setup.expected(&nominal).ok_or_else(|| HarnessError::Scenario {
-        scenario: config.label(),
-        reason: "the user does not change lanes within the horizon".to_owned(),
-    })?;
+    let nominal_expected = setup
+        .expected(&nominal)
+        .ok_or_else(|| HarnessError::Scenario {
+            scenario: config.label(),
+            reason: "the user does not change lanes within the horizon".to_owned(),
+        })?;
     let nominal_l = nominal_expected.sample(k, dt);
 
     let stopping = config.stopping;
@@ -226,7 +228,11 @@ pub fn run(
         if success(&records, streak, &stopping) {
             break Outcome::Personalized;
         }
-        if records.len() >= stopping.max_lane_changes.max(stopping.max_takeovers + stopping.success_streak) {
+        if records.len()
+            >= stopping
+                .max_lane_changes
+                .max(stopping.max_takeovers + stopping.success_streak)
+        {
             break Outcome::CapReached;
         }
     };
@@ -261,7 +267,11 @@ pub fn run(
 /// Whether the run has succeeded: `success_streak` takeover-free lane changes in a
 /// row for a deterministic user; for a user with spread, the takeover rate over the
 /// last window within the margin of the nominal plan's rate on the same draws.
-fn success(records: &[LaneChangeRecord], streak: usize, stopping: &crate::config::StoppingConfig) -> bool {
+fn success(
+    records: &[LaneChangeRecord],
+    streak: usize,
+    stopping: &crate::config::StoppingConfig,
+) -> bool {
     let with_spread = records.last().is_some_and(|r| r.with_spread);
     if !with_spread {
         return streak >= stopping.success_streak;
@@ -297,7 +307,12 @@ fn scenes(setup: &Setup, previous: Option<&[State]>) -> Vec<StepScene> {
 }
 
 /// Turns a taken-over lane change into a lesson, labelled by the method's rule.
-fn lesson(method: Method, setup: &Setup, drive: &Drive, takeover_step: usize) -> Result<Lesson, HarnessError> {
+fn lesson(
+    method: Method,
+    setup: &Setup,
+    drive: &Drive,
+    takeover_step: usize,
+) -> Result<Lesson, HarnessError> {
     let mut samples = Vec::new();
     let mut push = |state: &State, i: usize, driver: Driver| -> Result<(), HarnessError> {
         let Some(safe) = label(method, driver) else {
@@ -313,11 +328,18 @@ fn lesson(method: Method, setup: &Setup, drive: &Drive, takeover_step: usize) ->
                 adjacent: drive.adjacent[i],
             },
         )?;
-        samples.push(Sample::new(x, if safe { Label::Safe } else { Label::Unsafe }));
+        samples.push(Sample::new(
+            x,
+            if safe { Label::Safe } else { Label::Unsafe },
+        ));
         Ok(())
     };
     for (i, state) in drive.driven.iter().enumerate() {
-        let driver = if i < takeover_step { Driver::System } else { Driver::User };
+        let driver = if i < takeover_step {
+            Driver::System
+        } else {
+            Driver::User
+        };
         push(state, i, driver)?;
     }
     for (i, state) in drive.plan.states.iter().enumerate().skip(takeover_step) {
@@ -331,4 +353,3 @@ fn lesson(method: Method, setup: &Setup, drive: &Drive, takeover_step: usize) ->
         step_scenes: scenes(setup, Some(&drive.plan.states)),
     })
 }
-

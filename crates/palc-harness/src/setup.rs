@@ -49,7 +49,7 @@ impl Default for PlanningConfig {
             standard_alc: Style {
                 time_headway_s: 1.0,
                 lane_change_duration_s: 3.5,
-                min_lead_gap_s: 1.0,
+                min_lead_gap_s: 0.8,
             },
             target_l: 3.5,
             takeover_threshold_m: 0.3,
@@ -62,7 +62,10 @@ impl PlanningConfig {
     pub fn validate(&self) -> Result<(), HarnessError> {
         let positive = [
             ("planning.dt", self.dt),
-            ("planning.trigger_time_headway_s", self.trigger_time_headway_s),
+            (
+                "planning.trigger_time_headway_s",
+                self.trigger_time_headway_s,
+            ),
             ("planning.max_approach_s", self.max_approach_s),
             ("planning.search_window_s", self.search_window_s),
             ("planning.takeover_threshold_m", self.takeover_threshold_m),
@@ -72,7 +75,7 @@ impl PlanningConfig {
                 return Err(invalid(field, value, "a finite value > 0"));
             }
         }
-        if !(self.dt <= 0.5) {
+        if self.dt > 0.5 {
             return Err(invalid("planning.dt", self.dt, "at most 0.5 s"));
         }
         if !(self.horizon_margin_s.is_finite() && self.horizon_margin_s >= 0.0) {
@@ -137,11 +140,15 @@ impl Setup {
             .ego()
             .ok_or_else(|| scenario_error("the scene has no ego vehicle".to_owned()))?;
         let ego_speed = ego.state.v;
-        if !(ego_speed > 0.0) {
-            return Err(scenario_error(format!("the ego speed is {ego_speed} m/s, expected > 0")));
+        if ego_speed.is_nan() || ego_speed <= 0.0 {
+            return Err(scenario_error(format!(
+                "the ego speed is {ego_speed} m/s, expected > 0"
+            )));
         }
         if scene.preceding().is_none() {
-            return Err(scenario_error("the scene has no preceding vehicle".to_owned()));
+            return Err(scenario_error(
+                "the scene has no preceding vehicle".to_owned(),
+            ));
         }
 
         let mut scene = scene.clone();
@@ -170,8 +177,14 @@ impl Setup {
         let mut adjacent = Vec::with_capacity(window + 1);
         for step in 0..=window {
             situations.push(situation(&rollout));
-            preceding.push(relative(rollout.preceding().map(|v| (v.state.s, v.state.l)), origin_s));
-            adjacent.push(relative(rollout.adjacent().map(|v| (v.state.s, v.state.l)), origin_s));
+            preceding.push(relative(
+                rollout.preceding().map(|v| (v.state.s, v.state.l)),
+                origin_s,
+            ));
+            adjacent.push(relative(
+                rollout.adjacent().map(|v| (v.state.s, v.state.l)),
+                origin_s,
+            ));
             if step < window {
                 lane_keeping_step(&mut rollout, config.dt)?;
             }
@@ -243,7 +256,9 @@ impl Setup {
         let standard_start = self.standard_start_step as f64 * self.dt;
         for (name, style) in styles {
             let Some(expected) = self.expected(style) else {
-                return Err(format!("the {name} user does not change lanes within the horizon"));
+                return Err(format!(
+                    "the {name} user does not change lanes within the horizon"
+                ));
             };
             if expected.start_s >= standard_start {
                 return Err(format!(

@@ -281,7 +281,7 @@ mod tests {
         let situations = [
             at(2.0, Some(50.0)),
             at(1.2, Some(5.0)),
-            at(1.1, Some(12.0)),
+            at(1.1, Some(11.0)),
             at(1.0, Some(13.0)),
         ];
         assert_eq!(style.start_step(&situations), Some(3));

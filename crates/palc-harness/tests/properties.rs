@@ -1,0 +1,60 @@
+//! Property tests of the harness: perceived safety ratio and labelling.
+
+use palc_harness::user::{ExpectedLaneChange, first_takeover};
+use palc_harness::{Driver, LearnConfig, Method, execute, label, prepare, problem};
+use palc_planner::{Planner, PlannerConfig, Weights};
+use proptest::prelude::*;
+
+fn setup() -> (palc_harness::Setup, LearnConfig) {
+    let text = include_str!("../../../configs/learn.toml");
+    let config = LearnConfig::from_toml_str(text).unwrap();
+    (prepare(&config).unwrap(), config)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// The ratio is in [0, 1] and equals 1 exactly when there is no takeover, for
+    /// any expected lane change against the standard ALC's plan.
+    #[test]
+    fn perceived_safety_ratio_is_a_ratio(start in 0.0f64..12.0, duration in 1.5f64..3.5) {
+        let (setup, config) = setup();
+        let standard = setup.standard_lane_change(&config.planning.standard_alc);
+        let weights: Weights = config.standard_weights.weights(&standard, setup.horizon, setup.dt);
+        let mut planner = Planner::new(PlannerConfig {
+            horizon: setup.horizon,
+            dt: setup.dt,
+            ..config.planner.clone()
+        }).unwrap();
+        let plan = planner.plan(&problem(&setup, weights, Vec::new())).unwrap();
+        let expected = ExpectedLaneChange { start_s: start, duration_s: duration, from_l: 0.0, to_l: 3.5 };
+        let drive = execute(&setup, plan, expected, 0.3).unwrap();
+        prop_assert!((0.0..=1.0).contains(&drive.perceived_safety_ratio));
+        prop_assert_eq!(drive.perceived_safety_ratio == 1.0, drive.takeover.is_none());
+        // Who drove: the plan before the takeover, the user's expectation after it.
+        let planned: Vec<f64> = drive.plan.states.iter().map(|x| x.l).collect();
+        prop_assert_eq!(first_takeover(&planned, &drive.expected_l, 0.3), drive.takeover.map(|t| t.step));
+        if let Some(t) = drive.takeover {
+            for i in 0..t.step {
+                prop_assert_eq!(drive.driven[i].l, planned[i]);
+            }
+            for i in t.step..drive.driven.len() {
+                prop_assert!((drive.driven[i].l - drive.expected_l[i]).abs() < 1e-12);
+            }
+        } else {
+            prop_assert_eq!(drive.driven.len(), planned.len());
+        }
+    }
+}
+
+#[test]
+fn labels_follow_who_drove() {
+    // The paper: system-driven positions are safe (y = 1), user-driven unsafe (y = 0).
+    assert_eq!(label(Method::Paper, Driver::System), Some(true));
+    assert_eq!(label(Method::Paper, Driver::User), Some(false));
+    assert_eq!(label(Method::Paper, Driver::Rejected), None);
+    // palc: what the user accepted or drove is safe, what the user rejected is not.
+    assert_eq!(label(Method::Palc, Driver::System), Some(true));
+    assert_eq!(label(Method::Palc, Driver::User), Some(true));
+    assert_eq!(label(Method::Palc, Driver::Rejected), Some(false));
+}
