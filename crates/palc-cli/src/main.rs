@@ -17,6 +17,8 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Background traffic on its own (IDM scenes, platoons).
+    Traffic(commands::traffic::TrafficArgs),
     /// The perceived safe zone filter: fit on labelled samples, classify points.
     Zone(commands::zone::ZoneArgs),
 }
@@ -24,6 +26,7 @@ enum Command {
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.command {
+        Command::Traffic(args) => commands::traffic::run(args),
         Command::Zone(args) => commands::zone::run(args),
     }
 }

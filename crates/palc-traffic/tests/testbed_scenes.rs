@@ -75,7 +75,7 @@ fn a_cell_places_ego_preceding_and_adjacent_as_documented() {
     assert_eq!((adjacent.lane, adjacent.state.l), (Lane(1), 3.5));
     let lead = adjacent.state.s - ego.state.s;
     assert!(
-        lead >= 0.2 * 30.0 - 0.5 && lead <= 0.8 * 30.0 + 0.5,
+        (0.2 * 30.0 - 0.5..=0.8 * 30.0 + 0.5).contains(&lead),
         "adjacent lead {lead}"
     );
 

@@ -1,3 +1,4 @@
 //! One module per `palc` subcommand.
 
+pub mod traffic;
 pub mod zone;

@@ -1,0 +1,98 @@
+//! `palc traffic ...`: background traffic on its own.
+//!
+//! `palc traffic simulate` builds a scene from a scenario config and writes one CSV row per
+//! vehicle per step: `time,id,lane,s,l,v,a` (SI units). In a test-bed scene the ego has no
+//! planner here: it keeps its lane and follows its stand-in IDM (`Scene::step_autonomous`).
+
+use anyhow::{Context, bail};
+use clap::{Args, Subcommand};
+use palc_traffic::{ScenarioConfig, Scene};
+use std::path::PathBuf;
+
+/// Background traffic on its own.
+#[derive(Debug, Args)]
+pub struct TrafficArgs {
+    #[command(subcommand)]
+    command: TrafficCommand,
+}
+
+#[derive(Debug, Subcommand)]
+enum TrafficCommand {
+    /// Simulate a scenario config and write every vehicle's state per step as CSV.
+    Simulate(SimulateArgs),
+}
+
+#[derive(Debug, Args)]
+struct SimulateArgs {
+    /// Scenario config (TOML), e.g. configs/testbed.toml or configs/platoon.toml.
+    #[arg(long)]
+    config: PathBuf,
+    /// Simulated duration (s).
+    #[arg(long, default_value_t = 20.0)]
+    duration: f64,
+    /// Time step (s).
+    #[arg(long, default_value_t = 0.1)]
+    dt: f64,
+    /// Index of the test-bed cell to run (speed case, then headway, then seed); 0 for a platoon.
+    #[arg(long, default_value_t = 0)]
+    cell: usize,
+    /// Output CSV file.
+    #[arg(long)]
+    out: PathBuf,
+}
+
+/// Largest number of steps one run may write, so that a typo cannot fill the disk.
+const MAX_STEPS: f64 = 1e6;
+
+pub fn run(args: TrafficArgs) -> anyhow::Result<()> {
+    match args.command {
+        TrafficCommand::Simulate(args) => simulate(&args),
+    }
+}
+
+fn simulate(args: &SimulateArgs) -> anyhow::Result<()> {
+    let text = std::fs::read_to_string(&args.config)
+        .with_context(|| format!("cannot read config {}", args.config.display()))?;
+    let config = ScenarioConfig::from_toml_str(&text)
+        .with_context(|| format!("in {}", args.config.display()))?;
+    let mut scene = Scene::from_config(&config, args.cell)
+        .with_context(|| format!("in {}", args.config.display()))?;
+    if !(args.duration >= 0.0 && args.duration.is_finite()) {
+        bail!(
+            "--duration {} is out of range: it must be finite and at least 0 s",
+            args.duration
+        );
+    }
+    let steps = (args.duration / args.dt).round();
+    let valid = args.dt > 0.0 && steps <= MAX_STEPS;
+    if !valid {
+        bail!(
+            "--duration / --dt = {steps} steps is out of range: at most {MAX_STEPS} steps with dt above 0 s"
+        );
+    }
+    let mut writer = csv::Writer::from_path(&args.out)
+        .with_context(|| format!("cannot write {}", args.out.display()))?;
+    writer.write_record(["time", "id", "lane", "s", "l", "v", "a"])?;
+    // `steps` is a whole number in [0, MAX_STEPS] here, so the cast is exact.
+    for step in 0..=(steps as u64) {
+        if step > 0 {
+            scene.step_autonomous(args.dt)?;
+        }
+        for vehicle in scene.vehicles() {
+            let state = &vehicle.state;
+            writer.write_record([
+                format!("{:.4}", scene.time()),
+                vehicle.id.0.to_string(),
+                vehicle.lane.0.to_string(),
+                format!("{:.4}", state.s),
+                format!("{:.4}", state.l),
+                format!("{:.4}", state.v),
+                format!("{:.4}", state.a),
+            ])?;
+        }
+    }
+    writer
+        .flush()
+        .with_context(|| format!("cannot write {}", args.out.display()))?;
+    Ok(())
+}
