@@ -1,11 +1,13 @@
 //! Project tasks for palc, run as `cargo xtask <task>` from anywhere in the
 //! workspace (the alias lives in `.cargo/config.toml`).
 //!
+//! `reproduce-paper` regenerates the paper's evaluation (`reproduce/`).
 //! Repository hygiene lives in `tidy.rs` as ordinary tests, run by
 //! `cargo test --workspace`.
 
 use std::path::{Path, PathBuf};
 
+mod reproduce;
 #[cfg(test)]
 mod tidy;
 
@@ -17,6 +19,7 @@ fn main() -> anyhow::Result<()> {
             print_help();
             Ok(())
         }
+        Some("reproduce-paper") => reproduce::main(std::env::args().skip(2)),
         Some(other) => {
             print_help();
             anyhow::bail!("unknown task `{other}`")
@@ -25,7 +28,11 @@ fn main() -> anyhow::Result<()> {
 }
 
 fn print_help() {
-    println!("cargo xtask <task>\n\ntasks:\n  help    this text");
+    println!(
+        "cargo xtask <task>\n\ntasks:\n  \
+         reproduce-paper  regenerate the paper's evaluation (--quick, --jobs N, --out DIR)\n  \
+         help             this text"
+    );
 }
 
 /// The workspace root: the parent of this crate's manifest directory.

@@ -64,10 +64,18 @@ fn every_crate_has_a_section_in_the_architecture_document() {
     let architecture = read(&project_root().join("docs/ARCHITECTURE.md"));
     let missing: Vec<String> = crate_dirs()
         .iter()
-        .map(|dir| format!("### `crates/{}`", dir.file_name().unwrap().to_string_lossy()))
+        .map(|dir| {
+            format!(
+                "### `crates/{}`",
+                dir.file_name().unwrap().to_string_lossy()
+            )
+        })
         .filter(|heading| !architecture.contains(heading.as_str()))
         .collect();
-    assert!(missing.is_empty(), "docs/ARCHITECTURE.md lacks the sections {missing:?}");
+    assert!(
+        missing.is_empty(),
+        "docs/ARCHITECTURE.md lacks the sections {missing:?}"
+    );
 }
 
 #[test]
@@ -95,7 +103,10 @@ fn every_crate_root_starts_with_an_overview() {
         .filter(|path| path.is_file() && !read(path).trim_start().starts_with("//!"))
         .map(|path| path.display().to_string())
         .collect();
-    assert!(missing.is_empty(), "crate roots without a `//!` overview: {missing:?}");
+    assert!(
+        missing.is_empty(),
+        "crate roots without a `//!` overview: {missing:?}"
+    );
 }
 
 #[test]

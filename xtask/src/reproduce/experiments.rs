@@ -1,0 +1,307 @@
+//! The experiments of Section III as views of the runs: which rows each figure
+//! and table uses, and the figures drawn from them (Figs. 6-13).
+
+use std::path::Path;
+
+use super::figures::{self, Bars, Example, Lines};
+use super::harness_runs::ExampleTrace;
+use super::plan::Experiment;
+use super::results::{PART_NAMES, RunRow};
+use super::stats;
+
+/// A figure written to the output directory.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FigureFile {
+    /// File stem; `stem.svg` and `stem.png` exist.
+    pub stem: String,
+    /// What it shows.
+    pub caption: String,
+}
+
+/// The grid rows (no experience) of one method and user kind, in plan order.
+pub fn grid<'a>(rows: &'a [RunRow], method: &str, user: &str) -> Vec<&'a RunRow> {
+    rows.iter()
+        .filter(|r| {
+            r.spec.experiment == Experiment::Grid
+                && r.spec.method == method
+                && r.spec.user.name == user
+        })
+        .collect()
+}
+
+/// Grid and transfer rows of one method and user kind.
+pub fn with_transfer<'a>(rows: &'a [RunRow], method: &str, user: &str) -> Vec<&'a RunRow> {
+    rows.iter()
+        .filter(|r| {
+            r.spec.experiment != Experiment::Timing
+                && r.spec.method == method
+                && r.spec.user.name == user
+        })
+        .collect()
+}
+
+/// The timing rows of one method.
+pub fn timing<'a>(rows: &'a [RunRow], method: &str) -> Vec<&'a RunRow> {
+    rows.iter()
+        .filter(|r| r.spec.experiment == Experiment::Timing && r.spec.method == method)
+        .collect()
+}
+
+/// A name usable in a file name.
+pub fn slug(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '-'
+            }
+        })
+        .collect::<String>()
+        .trim_matches('-')
+        .to_owned()
+}
+
+/// Speed-case label with its speeds.
+pub fn speed_label(row: &RunRow) -> String {
+    let case = &row.spec.speed_case;
+    format!(
+        "{} ({:.0}/{:.0} mph)",
+        case.name, case.ego_mph, case.others_mph
+    )
+}
+
+fn means_by(
+    rows: &[RunRow],
+    methods: &[String],
+    user: &str,
+    key: &dyn Fn(&RunRow) -> String,
+) -> (Vec<String>, Vec<(String, Vec<Option<f64>>)>) {
+    let all: Vec<&RunRow> = methods.iter().flat_map(|m| grid(rows, m, user)).collect();
+    let categories: Vec<String> = stats::by(&all, key).into_iter().map(|(k, _)| k).collect();
+    let series = methods
+        .iter()
+        .map(|method| {
+            let groups = stats::by(&grid(rows, method, user), key);
+            let values = (categories.iter())
+                .map(|c| {
+                    groups
+                        .iter()
+                        .find(|(k, _)| k == c)
+                        .and_then(|(_, s)| s.mean)
+                })
+                .collect();
+            (method.clone(), values)
+        })
+        .collect();
+    (categories, series)
+}
+
+/// Draws every figure into `dir`.
+pub fn draw_all(
+    rows: &[RunRow],
+    methods: &[String],
+    users: &[String],
+    example: Option<&ExampleTrace>,
+    dir: &Path,
+) -> anyhow::Result<Vec<FigureFile>> {
+    figures::register_bundled_font()?;
+    let mut files = Vec::new();
+    let mut save =
+        |stem: String, caption: String, figure: &dyn Fn(&Path, &str) -> anyhow::Result<()>| {
+            figure(dir, &stem)?;
+            files.push(FigureFile { stem, caption });
+            anyhow::Ok(())
+        };
+    if let Some(trace) = example {
+        save(
+            "fig06-example".into(),
+            format!("Fig. 6: qualitative example, {}", trace.label),
+            &|dir, stem| figures::save(dir, stem, (1400, 560), &Example { trace }).map(|_| ()),
+        )?;
+    }
+    for user in users {
+        let tag = slug(user);
+        let cap = rows.iter().map(|r| r.cap).max().unwrap_or(30);
+        let categories: Vec<String> = (0..=cap).map(|n| n.to_string()).collect();
+        let series: Vec<(String, Vec<Option<f64>>)> = methods
+            .iter()
+            .map(|method| {
+                let mut counts = vec![0usize; cap + 1];
+                for row in grid(rows, method, user)
+                    .iter()
+                    .filter(|r| r.status.counted())
+                {
+                    counts[row.counted_takeovers().min(cap)] += 1;
+                }
+                let counts = counts.into_iter().map(|c| Some(c as f64)).collect();
+                (method.clone(), counts)
+            })
+            .collect();
+        let histogram = Bars {
+            title: format!("Takeovers to personalization ({user} users; {cap} = failed)"),
+            x_desc: "takeovers".into(),
+            y_desc: "runs".into(),
+            categories,
+            series,
+            label_every: 5,
+        };
+        save(
+            format!("fig07-takeovers-{tag}"),
+            format!(
+                "Fig. 7: distribution of takeovers to personalization, {user} users (a failure is counted at the cap)"
+            ),
+            &|dir, stem| figures::save(dir, stem, (900, 450), &histogram).map(|_| ()),
+        )?;
+        let sensitivity: [(&str, &str, &str, &dyn Fn(&RunRow) -> String); 3] = [
+            (
+                "fig08-style",
+                "Fig. 8: mean takeovers by driving style",
+                "style",
+                &|r| r.spec.style.clone(),
+            ),
+            (
+                "fig09-speed",
+                "Fig. 9: mean takeovers by speed case (ego/others)",
+                "speed case",
+                &speed_label,
+            ),
+            (
+                "fig10-congestion",
+                "Fig. 10: mean takeovers by adjacent headway (congestion)",
+                "adjacent headway (m)",
+                &|r| format!("{}", r.spec.headway_m),
+            ),
+        ];
+        for (stem, caption, x_desc, key) in sensitivity {
+            let (categories, series) = means_by(rows, methods, user, key);
+            let figure = Bars {
+                title: format!("{caption} ({user})"),
+                x_desc: x_desc.into(),
+                y_desc: "mean takeovers (failures at the cap)".into(),
+                categories,
+                series,
+                label_every: 1,
+            };
+            save(
+                format!("{stem}-{tag}"),
+                format!("{caption}, {user} users"),
+                &|dir, stem| figures::save(dir, stem, (900, 450), &figure).map(|_| ()),
+            )?;
+        }
+        let transfers: Vec<(String, stats::Transfer)> = methods
+            .iter()
+            .map(|m| (m.clone(), stats::transfer(&with_transfer(rows, m, user))))
+            .filter(|(_, t)| t.pairs > 0)
+            .collect();
+        if !transfers.is_empty() {
+            let figure = Bars {
+                title: format!("Experience accumulation ({user})"),
+                x_desc: String::new(),
+                y_desc: "mean takeovers over the same cells".into(),
+                categories: vec!["without experience".into(), "with experience".into()],
+                series: transfers
+                    .iter()
+                    .map(|(m, t)| (m.clone(), vec![t.without, t.with]))
+                    .collect(),
+                label_every: 1,
+            };
+            save(
+                format!("fig11-experience-{tag}"),
+                format!(
+                    "Fig. 11: mean takeovers with and without experience from another scenario, {user} users"
+                ),
+                &|dir, stem| figures::save(dir, stem, (700, 450), &figure).map(|_| ()),
+            )?;
+        }
+        let safety = Lines {
+            title: format!("Perceived safety distance ratio ({user})"),
+            x_desc: "lane change".into(),
+            y_desc: "mean ratio over the runs still learning".into(),
+            series: methods
+                .iter()
+                .map(|m| {
+                    let s = stats::safety(&grid(rows, m, user));
+                    let points = (s.mean_by_iteration.iter().enumerate())
+                        .map(|(i, &(mean, _))| ((i + 1) as f64, mean))
+                        .collect();
+                    (m.clone(), points)
+                })
+                .collect(),
+            y_range: Some((0.0, 1.05)),
+        };
+        save(
+            format!("fig12-safety-{tag}"),
+            format!(
+                "Fig. 12: perceived safety distance ratio against the lane change, {user} users (mean over the runs that drove it)"
+            ),
+            &|dir, stem| figures::save(dir, stem, (900, 450), &safety).map(|_| ()),
+        )?;
+    }
+    let mut series = Vec::new();
+    for method in methods {
+        let timed = timing(rows, method);
+        let mut dts: Vec<f64> = timed.iter().filter_map(|r| r.dt).collect();
+        dts.sort_by(f64::total_cmp);
+        dts.dedup();
+        for dt in dts {
+            let mut points: Vec<(f64, f64)> = Vec::new();
+            let mut horizons: Vec<usize> = timed
+                .iter()
+                .filter(|r| r.dt == Some(dt))
+                .map(|r| r.horizon)
+                .collect();
+            horizons.sort_unstable();
+            horizons.dedup();
+            for k in horizons {
+                let group = timed
+                    .iter()
+                    .copied()
+                    .filter(|r| r.dt == Some(dt) && r.horizon == k);
+                if let Some(t) = stats::timing(group) {
+                    points.push((k as f64, t.p95 * 1e3));
+                }
+            }
+            if !points.is_empty() {
+                series.push((format!("{method}, dt {dt} s"), points));
+            }
+        }
+    }
+    if !series.is_empty() {
+        let figure = Lines {
+            title: "Compute time per iteration, p95".into(),
+            x_desc: "horizon K (steps)".into(),
+            y_desc: "ms".into(),
+            series,
+            y_range: None,
+        };
+        save(
+            "fig13-compute".into(),
+            "Fig. 13: compute time per iteration (95th percentile) against the horizon K, by method and step".into(),
+            &|dir, stem| figures::save(dir, stem, (900, 450), &figure).map(|_| ()),
+        )?;
+        let parts = Bars {
+            title: "Compute time per iteration by part (mean)".into(),
+            x_desc: "part".into(),
+            y_desc: "ms".into(),
+            categories: PART_NAMES.iter().map(|s| s.to_string()).collect(),
+            series: methods
+                .iter()
+                .filter_map(|m| {
+                    let t = stats::timing(timing(rows, m))?;
+                    Some((
+                        m.clone(),
+                        t.part_means.iter().map(|v| Some(v * 1e3)).collect(),
+                    ))
+                })
+                .collect(),
+            label_every: 1,
+        };
+        save(
+            "fig13-parts".into(),
+            "Fig. 13 (parts): mean compute time per iteration by part, over the timing runs".into(),
+            &|dir, stem| figures::save(dir, stem, (900, 450), &parts).map(|_| ()),
+        )?;
+    }
+    Ok(files)
+}

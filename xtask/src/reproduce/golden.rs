@@ -1,0 +1,127 @@
+//! Regression test on a small fixed subset of the reproduction, run through the
+//! real harness: the results are deterministic for a seed, do not depend on the
+//! number of threads, and their key statistics match `xtask/tests/golden/quick.json`.
+//!
+//! When the model changes on purpose, rewrite the golden file with
+//! `PALC_UPDATE_GOLDEN=1 cargo test -p xtask golden` and give the reason in the
+//! commit message.
+
+use serde::{Deserialize, Serialize};
+
+use super::config::{ReproduceConfig, Selection, TimingConfig, TransferConfig, TransferSource};
+use super::harness_runs::HarnessRuns;
+use super::plan;
+use super::results::RunRow;
+use super::runner::{self, Progress};
+use super::stats::Summary;
+
+/// The key numbers of one run, rounded so that the file is readable.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct GoldenRun {
+    run: String,
+    outcome: String,
+    takeovers: usize,
+    lane_changes: usize,
+    horizon: usize,
+    final_max_deviation_mm: Option<i64>,
+}
+
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+struct Golden {
+    runs: Vec<GoldenRun>,
+    mean_takeovers_by_method: Vec<(String, Option<f64>)>,
+}
+
+fn golden_path() -> std::path::PathBuf {
+    crate::project_root().join("xtask/tests/golden/quick.json")
+}
+
+/// Two speed cases, one headway, two styles, one seed, deterministic users,
+/// both methods, with the transfer experiment.
+fn subset(config: &ReproduceConfig) -> Selection {
+    let mut selection = config.select(true).expect("the quick subset is valid");
+    selection.grid.speed_cases = vec!["collector-high".into(), "collector-slow".into()];
+    selection.grid.headways_m = vec![40.0];
+    selection.grid.styles = vec!["aggressive".into(), "cautious".into()];
+    selection.grid.seeds = vec![1];
+    selection.users.retain(|u| u.spread_relative.is_none());
+    selection.transfer = TransferConfig {
+        source: TransferSource::NextSpeedCase,
+        users: selection.users.iter().map(|u| u.name.clone()).collect(),
+    };
+    selection.timing = TimingConfig {
+        dts: Vec::new(),
+        ..selection.timing
+    };
+    selection
+}
+
+fn golden(rows: &[RunRow], methods: &[String]) -> Golden {
+    Golden {
+        runs: rows
+            .iter()
+            .map(|r| GoldenRun {
+                run: r.spec.label(),
+                outcome: r.status.name().to_owned(),
+                takeovers: r.counted_takeovers(),
+                lane_changes: r.lane_changes,
+                horizon: r.horizon,
+                final_max_deviation_mm: r.final_max_deviation_m.map(|d| (d * 1e3).round() as i64),
+            })
+            .collect(),
+        mean_takeovers_by_method: methods
+            .iter()
+            .map(|m| {
+                let rows = rows
+                    .iter()
+                    .filter(|r| &r.spec.method == m && r.spec.experiment == plan::Experiment::Grid);
+                (m.clone(), Summary::of(rows).mean)
+            })
+            .collect(),
+    }
+}
+
+#[test]
+fn the_quick_subset_is_deterministic_and_matches_the_golden_file() {
+    let root = crate::project_root();
+    let config_path = root.join("configs/reproduce.toml");
+    let text = std::fs::read_to_string(&config_path).unwrap();
+    let config = ReproduceConfig::from_toml_str(&text).unwrap();
+    let base = std::fs::read_to_string(config.base_path(&config_path)).unwrap();
+    let harness = HarnessRuns::from_toml_str(&base).unwrap();
+    let selection = subset(&config);
+    let plan = plan::expand(&selection, &harness.speed_cases().unwrap()).unwrap();
+    assert!(!plan.transfer.is_empty());
+
+    let one = runner::execute(&plan, &harness, 1, &Progress::new(plan.len(), true)).unwrap();
+    let two = runner::execute(&plan, &harness, 2, &Progress::new(plan.len(), true)).unwrap();
+    let strip = |rows: &[RunRow]| rows.iter().map(RunRow::without_timing).collect::<Vec<_>>();
+    assert_eq!(
+        strip(&one),
+        strip(&two),
+        "results depend on the number of threads"
+    );
+
+    let measured = golden(&one, &selection.grid.methods);
+    let path = golden_path();
+    if std::env::var_os("PALC_UPDATE_GOLDEN").is_some() {
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        let text = serde_json::to_string_pretty(&measured).unwrap() + "\n";
+        std::fs::write(&path, text).unwrap();
+        return;
+    }
+    let stored: Golden = serde_json::from_str(&std::fs::read_to_string(&path).unwrap_or_else(|e| {
+        panic!(
+            "cannot read {}: {e}; create it with `PALC_UPDATE_GOLDEN=1 cargo test -p xtask golden`",
+            path.display()
+        )
+    }))
+    .unwrap();
+    assert_eq!(
+        measured,
+        stored,
+        "the quick subset's results changed; if the model changed on purpose, rewrite {} with \
+         `PALC_UPDATE_GOLDEN=1 cargo test -p xtask golden` and say why in the commit message",
+        path.display()
+    );
+}

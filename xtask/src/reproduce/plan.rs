@@ -1,0 +1,396 @@
+//! Expanding the config into a list of runs, in a fixed order.
+//!
+//! The order of the list is the order of every output, whatever the number of
+//! threads: runs are executed in parallel but collected by index.
+
+use anyhow::{Context, bail};
+use serde::{Deserialize, Serialize};
+
+use super::config::{Selection, TransferSource, UserKind};
+
+/// The experiment a run belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Experiment {
+    /// The grid, started without experience (Figs. 7-10, 12).
+    Grid,
+    /// A grid cell started with experience from another scenario (Fig. 11).
+    Transfer,
+    /// Compute time against step and horizon (Fig. 13).
+    Timing,
+}
+
+impl Experiment {
+    /// Name in CSV and reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Experiment::Grid => "grid",
+            Experiment::Transfer => "transfer",
+            Experiment::Timing => "timing",
+        }
+    }
+}
+
+/// A speed case with its speeds, looked up in the base config.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SpeedCase {
+    /// Name, e.g. `collector-high`.
+    pub name: String,
+    /// Ego speed (mph).
+    pub ego_mph: f64,
+    /// Speed of the surrounding traffic (mph).
+    pub others_mph: f64,
+}
+
+/// One run of the loop: everything that differs from the base config.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunSpec {
+    /// Index in the run list.
+    pub id: usize,
+    /// Which experiment.
+    pub experiment: Experiment,
+    /// `paper` or `palc`.
+    pub method: String,
+    /// The user kind.
+    pub user: UserKind,
+    /// Style name.
+    pub style: String,
+    /// Speed case.
+    pub speed_case: SpeedCase,
+    /// Adjacent headway (m).
+    pub headway_m: f64,
+    /// Scene seed (and seed of the user's draws).
+    pub seed: u64,
+    /// Step override (timing experiment).
+    pub dt: Option<f64>,
+    /// Horizon margin override (timing experiment).
+    pub horizon_margin_s: Option<f64>,
+    /// Index of the run whose learned experience this run starts from.
+    pub experience_from: Option<usize>,
+}
+
+/// What identifies a scenario and user apart from the experiment: a transfer
+/// run and the grid run of the same cell share it.
+pub type CellKey = (String, String, String, String, u64, u64);
+
+impl RunSpec {
+    /// The cell of this run: method, user, style, speed case, headway bits, seed.
+    pub fn experiment_cell(&self) -> CellKey {
+        (
+            self.method.clone(),
+            self.user.name.clone(),
+            self.style.clone(),
+            self.speed_case.name.clone(),
+            self.headway_m.to_bits(),
+            self.seed,
+        )
+    }
+
+    /// A short label for progress lines and error lists.
+    pub fn label(&self) -> String {
+        let mut label = format!(
+            "{} {} {} {} / {} m / seed {} / {}",
+            self.experiment.name(),
+            self.method,
+            self.user.name,
+            self.style,
+            self.headway_m,
+            self.seed,
+            self.speed_case.name
+        );
+        if let Some(dt) = self.dt {
+            label.push_str(&format!(" / dt {dt}"));
+        }
+        if let Some(margin) = self.horizon_margin_s {
+            label.push_str(&format!(" / margin {margin} s"));
+        }
+        label
+    }
+}
+
+/// The runs of a selection, in two phases: runs without experience first, then
+/// the transfer runs, which need the experience of phase-one runs.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RunPlan {
+    /// Grid and timing runs.
+    pub first: Vec<RunSpec>,
+    /// Transfer runs; `experience_from` points into `first`.
+    pub transfer: Vec<RunSpec>,
+}
+
+impl RunPlan {
+    /// Every run, phase one first.
+    #[cfg(test)]
+    pub fn all(&self) -> impl Iterator<Item = &RunSpec> {
+        self.first.iter().chain(&self.transfer)
+    }
+
+    /// Number of runs.
+    pub fn len(&self) -> usize {
+        self.first.len() + self.transfer.len()
+    }
+}
+
+/// Expands a selection; `speed_cases` are the base config's (name, ego, others).
+pub fn expand(selection: &Selection, speed_cases: &[SpeedCase]) -> anyhow::Result<RunPlan> {
+    let lookup = |name: &str| -> anyhow::Result<SpeedCase> {
+        speed_cases
+            .iter()
+            .find(|case| case.name == name)
+            .cloned()
+            .with_context(|| {
+                let names: Vec<&str> = speed_cases.iter().map(|c| c.name.as_str()).collect();
+                format!("unknown speed case `{name}`: the base config defines {names:?}")
+            })
+    };
+    let grid = &selection.grid;
+    let mut first = Vec::new();
+    for method in &grid.methods {
+        for user in &selection.users {
+            for case in &grid.speed_cases {
+                for &headway_m in &grid.headways_m {
+                    for style in &grid.styles {
+                        for &seed in &grid.seeds {
+                            first.push(RunSpec {
+                                id: first.len(),
+                                experiment: Experiment::Grid,
+                                method: method.clone(),
+                                user: user.clone(),
+                                style: style.clone(),
+                                speed_case: lookup(case)?,
+                                headway_m,
+                                seed,
+                                dt: None,
+                                horizon_margin_s: None,
+                                experience_from: None,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let timing = &selection.timing;
+    let deterministic = UserKind {
+        name: "deterministic".to_owned(),
+        spread_relative: None,
+    };
+    for method in &timing.methods {
+        for &dt in &timing.dts {
+            for &margin in &timing.horizon_margins_s {
+                for style in &timing.styles {
+                    first.push(RunSpec {
+                        id: first.len(),
+                        experiment: Experiment::Timing,
+                        method: method.clone(),
+                        user: deterministic.clone(),
+                        style: style.clone(),
+                        speed_case: lookup(&timing.speed_case)?,
+                        headway_m: timing.headway_m,
+                        seed: timing.seed,
+                        dt: Some(dt),
+                        horizon_margin_s: Some(margin),
+                        experience_from: None,
+                    });
+                }
+            }
+        }
+    }
+    let mut transfer = Vec::new();
+    for target in first.iter().filter(|s| s.experiment == Experiment::Grid) {
+        if !selection.transfer.users.contains(&target.user.name) {
+            continue;
+        }
+        let source = transfer_source(selection, target, &first)?;
+        let Some(source) = source else { continue };
+        transfer.push(RunSpec {
+            id: first.len() + transfer.len(),
+            experiment: Experiment::Transfer,
+            experience_from: Some(source),
+            ..target.clone()
+        });
+    }
+    Ok(RunPlan { first, transfer })
+}
+
+/// The phase-one grid run whose experience `target` starts from; `None` when the
+/// grid has a single speed case (or headway), so that there is no other scenario.
+fn transfer_source(
+    selection: &Selection,
+    target: &RunSpec,
+    first: &[RunSpec],
+) -> anyhow::Result<Option<usize>> {
+    let grid = &selection.grid;
+    let next = |len: usize, index: usize| (index + 1) % len;
+    let (case, headway) = match selection.transfer.source {
+        TransferSource::NextSpeedCase => {
+            if grid.speed_cases.len() < 2 {
+                return Ok(None);
+            }
+            let i = position(&grid.speed_cases, &target.speed_case.name)?;
+            (
+                grid.speed_cases[next(grid.speed_cases.len(), i)].clone(),
+                target.headway_m,
+            )
+        }
+        TransferSource::NextHeadway => {
+            if grid.headways_m.len() < 2 {
+                return Ok(None);
+            }
+            let i = grid
+                .headways_m
+                .iter()
+                .position(|&h| h == target.headway_m)
+                .context("a grid run's headway is in the grid")?;
+            (
+                target.speed_case.name.clone(),
+                grid.headways_m[next(grid.headways_m.len(), i)],
+            )
+        }
+    };
+    let source = first.iter().find(|s| {
+        s.experiment == Experiment::Grid
+            && s.method == target.method
+            && s.user == target.user
+            && s.style == target.style
+            && s.seed == target.seed
+            && s.speed_case.name == case
+            && s.headway_m == headway
+    });
+    match source {
+        Some(source) => Ok(Some(source.id)),
+        None => bail!(
+            "no grid run to take experience from for `{}`",
+            target.label()
+        ),
+    }
+}
+
+fn position(names: &[String], name: &str) -> anyhow::Result<usize> {
+    names
+        .iter()
+        .position(|n| n == name)
+        .with_context(|| format!("`{name}` is not in the grid"))
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::super::config::{
+        ExampleConfig, GridConfig, TimingConfig, TransferConfig, TransferSource,
+    };
+    use super::*;
+
+    pub(crate) fn speed_cases() -> Vec<SpeedCase> {
+        [
+            ("collector-high", 45.0, 40.0),
+            ("collector-slow", 45.0, 35.0),
+            ("arterial-high", 65.0, 60.0),
+            ("arterial-slow", 65.0, 55.0),
+        ]
+        .into_iter()
+        .map(|(name, ego_mph, others_mph)| SpeedCase {
+            name: name.to_owned(),
+            ego_mph,
+            others_mph,
+        })
+        .collect()
+    }
+
+    pub(crate) fn selection() -> Selection {
+        Selection {
+            grid: GridConfig {
+                methods: vec!["paper".into(), "palc".into()],
+                speed_cases: vec!["collector-high".into(), "arterial-slow".into()],
+                headways_m: vec![50.0, 30.0],
+                styles: vec!["aggressive".into(), "neutral".into(), "cautious".into()],
+                seeds: vec![1, 2],
+            },
+            users: vec![
+                UserKind {
+                    name: "deterministic".into(),
+                    spread_relative: None,
+                },
+                UserKind {
+                    name: "spread".into(),
+                    spread_relative: Some(0.02),
+                },
+            ],
+            transfer: TransferConfig {
+                source: TransferSource::NextSpeedCase,
+                users: vec!["deterministic".into()],
+            },
+            timing: TimingConfig {
+                methods: vec!["palc".into()],
+                dts: vec![0.1, 0.05],
+                horizon_margins_s: vec![0.0, 1.0],
+                styles: vec!["neutral".into()],
+                speed_case: "collector-high".into(),
+                headway_m: 40.0,
+                seed: 1,
+            },
+            example: ExampleConfig {
+                method: "palc".into(),
+                style: "aggressive".into(),
+                speed_case: "collector-high".into(),
+                headway_m: 40.0,
+                seed: 1,
+            },
+        }
+    }
+
+    #[test]
+    fn the_grid_expands_to_every_combination_with_dense_ids() {
+        let plan = expand(&selection(), &speed_cases()).unwrap();
+        let grid = plan
+            .first
+            .iter()
+            .filter(|s| s.experiment == Experiment::Grid)
+            .count();
+        assert_eq!(grid, 2 * 2 * 2 * 2 * 3 * 2);
+        let timing = plan
+            .first
+            .iter()
+            .filter(|s| s.experiment == Experiment::Timing)
+            .count();
+        assert_eq!(timing, 4);
+        // Transfer: deterministic users only, every grid cell once.
+        assert_eq!(plan.transfer.len(), grid / 2);
+        for (i, spec) in plan.all().enumerate() {
+            assert_eq!(spec.id, i);
+        }
+    }
+
+    #[test]
+    fn a_transfer_run_takes_the_same_user_from_the_next_speed_case() {
+        let plan = expand(&selection(), &speed_cases()).unwrap();
+        for target in &plan.transfer {
+            let source = &plan.first[target.experience_from.unwrap()];
+            assert_eq!(source.experiment, Experiment::Grid);
+            assert_eq!(
+                (
+                    &source.method,
+                    &source.user,
+                    &source.style,
+                    source.seed,
+                    source.headway_m
+                ),
+                (
+                    &target.method,
+                    &target.user,
+                    &target.style,
+                    target.seed,
+                    target.headway_m
+                )
+            );
+            assert_ne!(source.speed_case, target.speed_case);
+        }
+    }
+
+    #[test]
+    fn an_unknown_speed_case_is_named() {
+        let mut selection = selection();
+        selection.grid.speed_cases.push("autobahn".into());
+        let error = expand(&selection, &speed_cases()).unwrap_err().to_string();
+        assert!(error.contains("autobahn"), "{error}");
+    }
+}

@@ -1,0 +1,271 @@
+//! What is kept of each run: one row of numbers, plus a few numbers per lane
+//! change (perceived safety, compute time), written to `runs.json` and `runs.csv`.
+
+use std::path::Path;
+
+use anyhow::Context;
+use serde::{Deserialize, Serialize};
+
+use super::plan::RunSpec;
+
+/// How a run ended, as the report counts it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case", tag = "kind")]
+pub enum Status {
+    /// The success criterion was met.
+    Personalized,
+    /// The takeover cap (or the lane-change cap of a user with spread) was reached.
+    CapReached,
+    /// The scenario was refused before running, e.g. because the standard ALC is
+    /// not conservative there; named in the report, not counted in statistics.
+    Refused {
+        /// Why.
+        reason: String,
+    },
+    /// The run stopped on an error; counted as a failure at the cap.
+    Failed {
+        /// The error.
+        error: String,
+    },
+}
+
+impl Status {
+    /// Name in CSV.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Status::Personalized => "personalized",
+            Status::CapReached => "cap-reached",
+            Status::Refused { .. } => "refused",
+            Status::Failed { .. } => "failed",
+        }
+    }
+
+    /// Whether the run counts in the takeover statistics (everything but a refusal).
+    pub fn counted(&self) -> bool {
+        !matches!(self, Status::Refused { .. })
+    }
+}
+
+/// One lane change, reduced to what the figures need.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Iteration {
+    /// Whether the user took over.
+    pub takeover: bool,
+    /// Perceived safety distance ratio (1 without takeover).
+    pub perceived_safety_ratio: f64,
+    /// Largest `|planned − expected|` (m).
+    pub max_deviation_m: f64,
+    /// Compute time by part: zone fit, bounds, expert, correction, plan (s).
+    pub times_s: [f64; 5],
+}
+
+/// Names of the parts of [`Iteration::times_s`].
+pub const PART_NAMES: [&str; 5] = ["zone fit", "bounds", "expert", "correction", "plan"];
+
+impl Iteration {
+    /// Total compute time of the iteration (s).
+    pub fn total_s(&self) -> f64 {
+        self.times_s.iter().sum()
+    }
+}
+
+/// One run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunRow {
+    /// What was run.
+    pub spec: RunSpec,
+    /// How it ended.
+    pub status: Status,
+    /// Takeovers to success; the cap for a run that did not personalize.
+    pub takeovers: usize,
+    /// The takeover cap of the run.
+    pub cap: usize,
+    /// Lane changes driven.
+    pub lane_changes: usize,
+    /// Largest `|planned − expected|` of the last lane change (m).
+    pub final_max_deviation_m: Option<f64>,
+    /// Takeover rate over the last window (users with spread).
+    pub final_takeover_rate: Option<f64>,
+    /// Takeover rate of the user's nominal plan on the same draws.
+    pub ceiling_takeover_rate: Option<f64>,
+    /// Planning horizon K.
+    pub horizon: usize,
+    /// Step (s).
+    pub dt: Option<f64>,
+    /// Wall time of the whole run (s).
+    pub wall_s: f64,
+    /// Every lane change.
+    pub iterations: Vec<Iteration>,
+}
+
+impl RunRow {
+    /// A row for a run that did not produce a result.
+    pub fn without_result(spec: RunSpec, status: Status, cap: usize, wall_s: f64) -> RunRow {
+        let takeovers = if status.counted() { cap } else { 0 };
+        RunRow {
+            spec,
+            status,
+            takeovers,
+            cap,
+            lane_changes: 0,
+            final_max_deviation_m: None,
+            final_takeover_rate: None,
+            ceiling_takeover_rate: None,
+            horizon: 0,
+            dt: None,
+            wall_s,
+            iterations: Vec::new(),
+        }
+    }
+
+    /// Takeovers as every statistic counts them: a failure counts at the cap.
+    pub fn counted_takeovers(&self) -> usize {
+        match self.status {
+            Status::Personalized => self.takeovers,
+            _ => self.cap.max(self.takeovers),
+        }
+    }
+
+    /// Whether the run personalized.
+    pub fn personalized(&self) -> bool {
+        self.status == Status::Personalized
+    }
+
+    /// Mean compute time per lane change (s); `None` without lane changes.
+    pub fn mean_compute_s(&self) -> Option<f64> {
+        if self.iterations.is_empty() {
+            return None;
+        }
+        let total: f64 = self.iterations.iter().map(Iteration::total_s).sum();
+        Some(total / self.iterations.len() as f64)
+    }
+
+    /// This row with every measured time set to zero: what must not depend on
+    /// the machine or the number of threads.
+    #[cfg(test)]
+    pub fn without_timing(&self) -> RunRow {
+        let mut row = self.clone();
+        row.wall_s = 0.0;
+        for iteration in &mut row.iterations {
+            iteration.times_s = [0.0; 5];
+        }
+        row
+    }
+}
+
+/// One line of `runs.csv`.
+#[derive(Debug, Serialize)]
+struct CsvRow<'a> {
+    id: usize,
+    experiment: &'a str,
+    method: &'a str,
+    user: &'a str,
+    style: &'a str,
+    speed_case: &'a str,
+    ego_mph: f64,
+    others_mph: f64,
+    headway_m: f64,
+    seed: u64,
+    dt_s: Option<f64>,
+    horizon: usize,
+    outcome: &'a str,
+    takeovers: usize,
+    lane_changes: usize,
+    final_max_deviation_m: Option<f64>,
+    final_takeover_rate: Option<f64>,
+    ceiling_takeover_rate: Option<f64>,
+    mean_compute_per_iteration_s: Option<f64>,
+    experience_from: Option<usize>,
+    note: String,
+}
+
+/// Writes `runs.json` (every field) and `runs.csv` (one line per run).
+pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> anyhow::Result<()> {
+    let text = serde_json::to_string_pretty(rows).context("cannot serialize the runs")?;
+    std::fs::write(json, text).with_context(|| format!("cannot write {}", json.display()))?;
+    let mut writer = csv::Writer::from_path(csv_path)
+        .with_context(|| format!("cannot write {}", csv_path.display()))?;
+    for row in rows {
+        let note = match &row.status {
+            Status::Refused { reason } => reason.clone(),
+            Status::Failed { error } => error.clone(),
+            _ => String::new(),
+        };
+        writer.serialize(CsvRow {
+            id: row.spec.id,
+            experiment: row.spec.experiment.name(),
+            method: &row.spec.method,
+            user: &row.spec.user.name,
+            style: &row.spec.style,
+            speed_case: &row.spec.speed_case.name,
+            ego_mph: row.spec.speed_case.ego_mph,
+            others_mph: row.spec.speed_case.others_mph,
+            headway_m: row.spec.headway_m,
+            seed: row.spec.seed,
+            dt_s: row.dt,
+            horizon: row.horizon,
+            outcome: row.status.name(),
+            takeovers: row.counted_takeovers(),
+            lane_changes: row.lane_changes,
+            final_max_deviation_m: row.final_max_deviation_m,
+            final_takeover_rate: row.final_takeover_rate,
+            ceiling_takeover_rate: row.ceiling_takeover_rate,
+            mean_compute_per_iteration_s: row.mean_compute_s(),
+            experience_from: row.spec.experience_from,
+            note,
+        })?;
+    }
+    writer
+        .flush()
+        .with_context(|| format!("cannot write {}", csv_path.display()))?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::runner::tests::synthetic_rows;
+    use super::*;
+
+    #[test]
+    fn csv_has_one_line_per_run_and_json_reads_back() {
+        let rows = synthetic_rows();
+        let dir = std::env::temp_dir().join(format!("palc-xtask-results-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (json, csv_path) = (dir.join("runs.json"), dir.join("runs.csv"));
+        write(&rows, &json, &csv_path).unwrap();
+        let text = std::fs::read_to_string(&csv_path).unwrap();
+        assert_eq!(text.lines().count(), rows.len() + 1);
+        let header = text.lines().next().unwrap();
+        for column in [
+            "method",
+            "user",
+            "style",
+            "speed_case",
+            "headway_m",
+            "seed",
+            "outcome",
+        ] {
+            assert!(header.split(',').any(|c| c == column), "{header}");
+        }
+        let back: Vec<RunRow> =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        assert_eq!(back.len(), rows.len());
+        assert_eq!(back[0].spec, rows[0].spec);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn a_failure_counts_at_the_cap() {
+        let mut row = synthetic_rows().remove(0);
+        row.status = Status::CapReached;
+        row.takeovers = 12;
+        row.cap = 30;
+        assert_eq!(row.counted_takeovers(), 30);
+        row.status = Status::Failed {
+            error: "solver".into(),
+        };
+        assert_eq!(row.counted_takeovers(), 30);
+        row.status = Status::Personalized;
+        assert_eq!(row.counted_takeovers(), 12);
+    }
+}

@@ -1,0 +1,338 @@
+//! Statistics over runs: takeovers to personalization (failures counted at the
+//! cap), success rates, trends, the experience reduction, perceived safety and
+//! compute-time percentiles.
+
+use std::collections::HashMap;
+
+use serde::Serialize;
+
+use super::plan::{CellKey, Experiment};
+use super::results::{Iteration, PART_NAMES, RunRow};
+
+/// Takeover statistics of a set of runs; refused runs are counted apart.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Summary {
+    /// Runs counted (every run but the refused ones).
+    pub runs: usize,
+    /// Runs refused before they started.
+    pub refused: usize,
+    /// Runs that personalized within the cap.
+    pub personalized: usize,
+    /// Mean takeovers, failures at the cap; `None` without runs.
+    pub mean: Option<f64>,
+    /// Fewest takeovers.
+    pub min: Option<usize>,
+    /// Most takeovers (the cap when a run failed).
+    pub max: Option<usize>,
+    /// Median takeovers.
+    pub median: Option<f64>,
+}
+
+impl Summary {
+    /// Summarizes `rows`.
+    pub fn of<'a>(rows: impl IntoIterator<Item = &'a RunRow>) -> Summary {
+        let mut counted = Vec::new();
+        let mut refused = 0;
+        let mut personalized = 0;
+        for row in rows {
+            if !row.status.counted() {
+                refused += 1;
+                continue;
+            }
+            personalized += usize::from(row.personalized());
+            counted.push(row.counted_takeovers());
+        }
+        counted.sort_unstable();
+        let n = counted.len();
+        let values: Vec<f64> = counted.iter().map(|&v| v as f64).collect();
+        Summary {
+            runs: n,
+            refused,
+            personalized,
+            mean: (n > 0).then(|| values.iter().sum::<f64>() / n as f64),
+            min: counted.first().copied(),
+            max: counted.last().copied(),
+            median: (n > 0).then(|| {
+                if n % 2 == 1 {
+                    values[n / 2]
+                } else {
+                    (values[n / 2 - 1] + values[n / 2]) / 2.0
+                }
+            }),
+        }
+    }
+
+    /// Share of counted runs that personalized.
+    pub fn success_rate(&self) -> Option<f64> {
+        (self.runs > 0).then(|| self.personalized as f64 / self.runs as f64)
+    }
+}
+
+/// Groups `rows` by `key`, in the order keys first appear, and summarizes each.
+pub fn by<'a, K: PartialEq + Clone>(
+    rows: &[&'a RunRow],
+    key: impl Fn(&RunRow) -> K,
+) -> Vec<(K, Summary)> {
+    let mut keys: Vec<K> = Vec::new();
+    for row in rows {
+        let k = key(row);
+        if !keys.contains(&k) {
+            keys.push(k);
+        }
+    }
+    keys.into_iter()
+        .map(|k| {
+            let group = rows.iter().copied().filter(|r| key(r) == k);
+            let summary = Summary::of(group);
+            (k, summary)
+        })
+        .collect()
+}
+
+/// Experience accumulation: runs with experience against the same cells without.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Transfer {
+    /// Cells where both runs were counted.
+    pub pairs: usize,
+    /// Mean takeovers without experience over those cells.
+    pub without: Option<f64>,
+    /// Mean takeovers with experience over those cells.
+    pub with: Option<f64>,
+    /// Personalized without / with experience.
+    pub personalized: (usize, usize),
+    /// Relative reduction `1 − with / without` (the paper: 0.24).
+    pub reduction: Option<f64>,
+    /// Transfer runs not counted (refused, or their source had no experience).
+    pub refused: usize,
+}
+
+/// Pairs each transfer run of `rows` with the grid run of its cell.
+pub fn transfer<'a>(rows: &[&'a RunRow]) -> Transfer {
+    let grid: HashMap<CellKey, &RunRow> = rows
+        .iter()
+        .filter(|r| r.spec.experiment == Experiment::Grid)
+        .map(|r| (r.spec.experiment_cell(), *r))
+        .collect();
+    let (mut without, mut with) = (Vec::new(), Vec::new());
+    let mut personalized = (0, 0);
+    let mut refused = 0;
+    for row in rows
+        .iter()
+        .filter(|r| r.spec.experiment == Experiment::Transfer)
+    {
+        let Some(base) = grid.get(&row.spec.experiment_cell()) else {
+            continue;
+        };
+        if !row.status.counted() || !base.status.counted() {
+            refused += usize::from(!row.status.counted());
+            continue;
+        }
+        without.push(base.counted_takeovers() as f64);
+        with.push(row.counted_takeovers() as f64);
+        personalized.0 += usize::from(base.personalized());
+        personalized.1 += usize::from(row.personalized());
+    }
+    let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
+    let (without_mean, with_mean) = (mean(&without), mean(&with));
+    Transfer {
+        pairs: without.len(),
+        without: without_mean,
+        with: with_mean,
+        personalized,
+        reduction: match (without_mean, with_mean) {
+            (Some(a), Some(b)) if a > 0.0 => Some(1.0 - b / a),
+            _ => None,
+        },
+        refused,
+    }
+}
+
+/// Perceived safety distance ratio against the lane-change index.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Safety {
+    /// Per lane-change index: mean ratio over the runs that drove that lane
+    /// change, and how many did.
+    pub mean_by_iteration: Vec<(f64, usize)>,
+    /// Personalized runs whose final takeover-free lane changes all have ratio 1.
+    pub personalized_at_one: usize,
+    /// Personalized runs.
+    pub personalized: usize,
+    /// Largest index of the last takeover of a personalized run (1-based), the
+    /// paper's "maximum number of required iterations" of Fig. 12(b).
+    pub max_takeovers_to_one: Option<usize>,
+}
+
+/// Perceived safety over `rows`.
+pub fn safety<'a>(rows: &[&'a RunRow]) -> Safety {
+    let longest = rows.iter().map(|r| r.iterations.len()).max().unwrap_or(0);
+    let mean_by_iteration = (0..longest)
+        .map(|i| {
+            let values: Vec<f64> = rows
+                .iter()
+                .filter_map(|r| r.iterations.get(i).map(|it| it.perceived_safety_ratio))
+                .collect();
+            (
+                values.iter().sum::<f64>() / values.len() as f64,
+                values.len(),
+            )
+        })
+        .collect();
+    let personalized: Vec<&&RunRow> = rows.iter().filter(|r| r.personalized()).collect();
+    let personalized_at_one = personalized
+        .iter()
+        .filter(|r| {
+            let clean = r.iterations.iter().rev().take_while(|it| !it.takeover);
+            let mut any = false;
+            let all_one = clean
+                .inspect(|_| any = true)
+                .all(|it| it.perceived_safety_ratio == 1.0);
+            any && all_one
+        })
+        .count();
+    Safety {
+        mean_by_iteration,
+        personalized_at_one,
+        personalized: personalized.len(),
+        max_takeovers_to_one: personalized.iter().map(|r| r.counted_takeovers()).max(),
+    }
+}
+
+/// Compute-time percentiles of a set of iterations (s).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Timing {
+    /// Iterations measured.
+    pub iterations: usize,
+    /// Mean total time.
+    pub mean: f64,
+    /// Median total time.
+    pub p50: f64,
+    /// 95th percentile of the total time.
+    pub p95: f64,
+    /// Largest total time.
+    pub max: f64,
+    /// Mean time of each part ([`PART_NAMES`]).
+    pub part_means: [f64; 5],
+    /// 95th percentile of each part.
+    pub part_p95: [f64; 5],
+}
+
+/// Nearest-rank percentile `q ∈ [0, 1]` of sorted values.
+pub fn percentile(sorted: &[f64], q: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    let rank = (q * sorted.len() as f64).ceil() as usize;
+    sorted[rank.clamp(1, sorted.len()) - 1]
+}
+
+/// Timing of every iteration of `rows`; `None` without iterations.
+pub fn timing<'a>(rows: impl IntoIterator<Item = &'a RunRow>) -> Option<Timing> {
+    let iterations: Vec<&Iteration> = rows.into_iter().flat_map(|r| &r.iterations).collect();
+    if iterations.is_empty() {
+        return None;
+    }
+    let sorted = |f: &dyn Fn(&Iteration) -> f64| {
+        let mut v: Vec<f64> = iterations.iter().map(|it| f(it)).collect();
+        v.sort_by(f64::total_cmp);
+        v
+    };
+    let totals = sorted(&Iteration::total_s);
+    let n = iterations.len() as f64;
+    let mut part_means = [0.0; PART_NAMES.len()];
+    let mut part_p95 = [0.0; PART_NAMES.len()];
+    for p in 0..PART_NAMES.len() {
+        let values = sorted(&|it: &Iteration| it.times_s[p]);
+        part_means[p] = values.iter().sum::<f64>() / n;
+        part_p95[p] = percentile(&values, 0.95);
+    }
+    Some(Timing {
+        iterations: iterations.len(),
+        mean: totals.iter().sum::<f64>() / n,
+        p50: percentile(&totals, 0.5),
+        p95: percentile(&totals, 0.95),
+        max: totals[totals.len() - 1],
+        part_means,
+        part_p95,
+    })
+}
+
+/// A trend: mean takeovers of two ends of a factor, and whether the paper's
+/// direction holds (`first` needs fewer takeovers than `second`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Trend {
+    /// The end the paper says needs fewer takeovers, and its mean.
+    pub first: (String, Option<f64>),
+    /// The other end, and its mean.
+    pub second: (String, Option<f64>),
+}
+
+impl Trend {
+    /// Whether `first` needs strictly fewer takeovers; `None` when a mean is missing.
+    pub fn agrees(&self) -> Option<bool> {
+        Some(self.first.1? < self.second.1?)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::results::Status;
+    use super::super::runner::tests::synthetic_rows;
+    use super::*;
+
+    #[test]
+    fn failures_count_at_the_cap_and_refusals_apart() {
+        let rows = synthetic_rows();
+        let mut picked: Vec<RunRow> = rows[..3].to_vec();
+        picked[0].status = Status::Personalized;
+        picked[0].takeovers = 4;
+        picked[1].status = Status::CapReached;
+        picked[1].takeovers = 30;
+        picked[1].cap = 30;
+        picked[2].status = Status::Refused { reason: "x".into() };
+        let summary = Summary::of(&picked);
+        assert_eq!(
+            (summary.runs, summary.refused, summary.personalized),
+            (2, 1, 1)
+        );
+        assert_eq!(summary.mean, Some(17.0));
+        assert_eq!((summary.min, summary.max), (Some(4), Some(30)));
+        assert_eq!(summary.median, Some(17.0));
+        assert_eq!(summary.success_rate(), Some(0.5));
+    }
+
+    #[test]
+    fn percentiles_use_the_nearest_rank() {
+        let values: Vec<f64> = (1..=100).map(f64::from).collect();
+        assert_eq!(percentile(&values, 0.5), 50.0);
+        assert_eq!(percentile(&values, 0.95), 95.0);
+        assert_eq!(percentile(&values, 1.0), 100.0);
+        assert_eq!(percentile(&[3.0], 0.95), 3.0);
+    }
+
+    #[test]
+    fn the_transfer_reduction_compares_the_same_cells() {
+        let rows = synthetic_rows();
+        let refs: Vec<&RunRow> = rows.iter().filter(|r| r.spec.method == "palc").collect();
+        let transfer = transfer(&refs);
+        assert!(transfer.pairs > 0);
+        // The synthetic executor needs three quarters of the takeovers (rounded down).
+        let reduction = transfer.reduction.unwrap();
+        assert!((0.2..0.4).contains(&reduction), "{reduction}");
+        assert!(
+            transfer.refused > 0,
+            "cells refused in the synthetic grid are counted"
+        );
+    }
+
+    #[test]
+    fn safety_reaches_one_after_the_last_takeover() {
+        let rows = synthetic_rows();
+        let refs: Vec<&RunRow> = rows.iter().filter(|r| r.spec.method == "palc").collect();
+        let safety = safety(&refs);
+        assert_eq!(safety.personalized_at_one, safety.personalized);
+        assert!(safety.mean_by_iteration[0].0 < 1.0);
+        let groups = by(&refs, |r| r.spec.style.clone());
+        assert_eq!(groups.len(), 3);
+        assert!(groups[0].1.mean < groups[2].1.mean);
+    }
+}
