@@ -40,7 +40,9 @@ enum ZoneCommand {
 
 #[derive(Debug, Args)]
 struct FitArgs {
-    /// Labelled samples, `.csv` or `.json` (see `palc zone --help` for the columns).
+    /// Labelled samples: `.csv` with a header naming the feature columns
+    /// (ds_p,dl_p,dist_p,ds_a,dl_a,dist_a by default) and `y` (1 = not taken over,
+    /// 0 = taken over), or `.json` as `[{"x": [..], "y": 0 or 1}, ..]`.
     #[arg(long)]
     samples: PathBuf,
     /// Where to write the model (JSON).
@@ -67,10 +69,12 @@ struct ClassifyArgs {
     /// A model written by `palc zone fit`.
     #[arg(long)]
     model: PathBuf,
-    /// Points to classify, `.csv` or `.json`.
+    /// Points to classify: `.csv` with the model's feature columns by name (other
+    /// columns ignored) or `.json` as `[[..features..], ..]`.
     #[arg(long)]
     points: PathBuf,
-    /// Output file, `.csv` or `.json`; CSV on stdout when absent.
+    /// Output, `.csv` (`class,p_safe` per point) or `.json`
+    /// (`[{"class": .., "p_safe": ..}]`); CSV on stdout when absent.
     #[arg(long)]
     out: Option<PathBuf>,
 }
