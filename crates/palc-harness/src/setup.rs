@@ -32,6 +32,10 @@ pub struct PlanningConfig {
     pub search_window_s: f64,
     /// The standard ALC before learning: conservative, later and slower than every style.
     pub standard_alc: Style,
+    /// The standard ALC starts no earlier than this long after the latest of the
+    /// paper's three styles (s): a conservative system waits until every style would
+    /// have gone, also when a user's start is set by a gap on the target lane.
+    pub standard_alc_min_delay_s: f64,
     /// Lateral position of the target lane's centre (m).
     pub target_l: f64,
     /// Deviation beyond which the user takes over (m); the paper's 0.3 m.
@@ -45,12 +49,13 @@ impl Default for PlanningConfig {
             trigger_time_headway_s: 2.2,
             horizon_margin_s: 1.0,
             max_approach_s: 60.0,
-            search_window_s: 30.0,
+            search_window_s: 60.0,
             standard_alc: Style {
                 time_headway_s: 1.0,
                 lane_change_duration_s: 3.5,
                 min_lead_gap_s: 0.8,
             },
+            standard_alc_min_delay_s: 0.5,
             target_l: 3.5,
             takeover_threshold_m: 0.3,
         }
@@ -77,6 +82,13 @@ impl PlanningConfig {
         }
         if self.dt > 0.5 {
             return Err(invalid("planning.dt", self.dt, "at most 0.5 s"));
+        }
+        if !(self.standard_alc_min_delay_s.is_finite() && self.standard_alc_min_delay_s >= 0.0) {
+            return Err(invalid(
+                "planning.standard_alc_min_delay_s",
+                self.standard_alc_min_delay_s,
+                "a finite value >= 0",
+            ));
         }
         if !(self.horizon_margin_s.is_finite() && self.horizon_margin_s >= 0.0) {
             return Err(invalid(
@@ -191,12 +203,24 @@ impl Setup {
         }
 
         let standard = &config.standard_alc;
-        let standard_start_step = standard.start_step(&situations).ok_or_else(|| {
+        let own_start = standard.start_step(&situations).ok_or_else(|| {
             scenario_error(format!(
                 "the standard ALC never starts within the {} s search window",
                 config.search_window_s
             ))
         })?;
+        let mut latest_user = 0;
+        for style in [Style::AGGRESSIVE, Style::NEUTRAL, Style::CAUTIOUS] {
+            let start = style.start_step(&situations).ok_or_else(|| {
+                scenario_error(format!(
+                    "a user ({} s headway) never starts within the {} s search window",
+                    style.time_headway_s, config.search_window_s
+                ))
+            })?;
+            latest_user = latest_user.max(start);
+        }
+        let delay = (config.standard_alc_min_delay_s / config.dt).ceil() as usize;
+        let standard_start_step = own_start.max(latest_user + delay);
         let end_s = standard_start_step as f64 * config.dt
             + standard.lane_change_duration_s
             + config.horizon_margin_s;
