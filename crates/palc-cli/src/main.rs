@@ -17,6 +17,8 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Learn a user's lane changes from takeovers (the lesson-learning loop).
+    Learn(commands::learn::LearnArgs),
     /// Background traffic on its own (IDM scenes, platoons).
     Traffic(commands::traffic::TrafficArgs),
     /// The perceived safe zone filter: fit on labelled samples, classify points.
@@ -26,6 +28,7 @@ enum Command {
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.command {
+        Command::Learn(args) => commands::learn::run_learn(args),
         Command::Traffic(args) => commands::traffic::run(args),
         Command::Zone(args) => commands::zone::run(args),
     }

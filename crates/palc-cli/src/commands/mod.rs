@@ -1,4 +1,5 @@
 //! One module per `palc` subcommand.
 
+pub mod learn;
 pub mod traffic;
 pub mod zone;

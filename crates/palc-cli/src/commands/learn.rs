@@ -1,0 +1,127 @@
+//! `palc learn`: runs the lesson-learning loop and shows each lane change.
+
+use std::path::PathBuf;
+
+use anyhow::Context;
+use clap::Args;
+use palc_aggregator::Experience;
+use palc_harness::{LaneChangeRecord, LearnConfig, Method, Observer, RunSummary, run};
+
+/// The default config, compiled in so that `palc learn` alone works anywhere.
+const DEFAULT_CONFIG: &str = include_str!("../../../../configs/learn.toml");
+
+/// Arguments of `palc learn`.
+#[derive(Debug, Args)]
+pub struct LearnArgs {
+    /// Run config (TOML); the paper's test bed and the `palc` method by default.
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// Learning method: `paper` or `palc`.
+    #[arg(long)]
+    method: Option<String>,
+    /// Driving style: `aggressive`, `neutral` or `cautious`.
+    #[arg(long)]
+    style: Option<String>,
+    /// Speed case by name, e.g. `collector-high`.
+    #[arg(long)]
+    speed: Option<String>,
+    /// Front-to-front headway on the target lane (m).
+    #[arg(long)]
+    headway: Option<f64>,
+    /// Seed of the scene.
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Start from experience saved in another run.
+    #[arg(long)]
+    experience: Option<PathBuf>,
+    /// Save what was learned.
+    #[arg(long)]
+    save_experience: Option<PathBuf>,
+    /// Write every lane change (trajectories, timings) as JSON.
+    #[arg(long)]
+    record: Option<PathBuf>,
+}
+
+/// Prints one line per lane change as it happens.
+struct Printer;
+
+impl Observer for Printer {
+    fn lane_change(&mut self, record: &LaneChangeRecord) {
+        match record.takeover {
+            Some(t) => println!(
+                "lane change {:>2}: takeover at {:5.1} s ({:6.1} m), deviation {:.2} m, perceived safety {:.2}",
+                record.index + 1,
+                t.time_s,
+                t.distance_m,
+                t.deviation_m,
+                record.perceived_safety_ratio
+            ),
+            None => println!(
+                "lane change {:>2}: no takeover, max deviation {:.2} m",
+                record.index + 1,
+                record.max_deviation_m
+            ),
+        }
+        if let Some(error) = &record.learning_error {
+            println!("               learning step failed, experience unchanged: {error}");
+        }
+    }
+
+    fn finished(&mut self, summary: &RunSummary) {
+        println!(
+            "{:?} after {} takeovers in {} lane changes (final max deviation {:.2} m)",
+            summary.outcome, summary.takeovers, summary.lane_changes, summary.final_max_deviation_m
+        );
+    }
+}
+
+/// Runs `palc learn`.
+pub fn run_learn(args: LearnArgs) -> anyhow::Result<()> {
+    let (text, source) = match &args.config {
+        Some(path) => (
+            std::fs::read_to_string(path)
+                .with_context(|| format!("cannot read {}", path.display()))?,
+            path.display().to_string(),
+        ),
+        None => (
+            DEFAULT_CONFIG.to_owned(),
+            "the built-in configs/learn.toml".to_owned(),
+        ),
+    };
+    let mut config = LearnConfig::from_toml_str(&text).with_context(|| format!("in {source}"))?;
+    if let Some(name) = &args.method {
+        config.method = Method::named(name)
+            .with_context(|| format!("unknown method `{name}`: expected `paper` or `palc`"))?;
+    }
+    if let Some(style) = &args.style {
+        config.user.style = style.clone();
+    }
+    if let Some(speed) = &args.speed {
+        config.cell.speed_case = speed.clone();
+    }
+    if let Some(headway) = args.headway {
+        config.cell.headway_m = headway;
+    }
+    if let Some(seed) = args.seed {
+        config.cell.seed = seed;
+    }
+    let experience = match &args.experience {
+        Some(path) => Some(
+            Experience::load(path).with_context(|| format!("cannot load {}", path.display()))?,
+        ),
+        None => None,
+    };
+    println!("{} ({} method)", config.label(), config.method.name());
+    let result = run(&config, experience.as_ref(), &mut Printer)?;
+    if let Some(path) = &args.save_experience {
+        result
+            .experience
+            .save(path)
+            .with_context(|| format!("cannot save {}", path.display()))?;
+    }
+    if let Some(path) = &args.record {
+        let json = serde_json::to_string_pretty(&result)?;
+        std::fs::write(path, json).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(())
+}
