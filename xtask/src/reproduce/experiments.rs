@@ -9,6 +9,12 @@ use super::plan::Experiment;
 use super::results::{PART_NAMES, RunRow};
 use super::stats;
 
+/// Series of a bar chart: name and one value per category.
+type BarSeries = Vec<(String, Vec<Option<f64>>)>;
+
+/// How rows are grouped into categories.
+type Key<'a> = &'a dyn Fn(&RunRow) -> String;
+
 /// A figure written to the output directory.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FigureFile {
@@ -76,7 +82,7 @@ fn means_by(
     methods: &[String],
     user: &str,
     key: &dyn Fn(&RunRow) -> String,
-) -> (Vec<String>, Vec<(String, Vec<Option<f64>>)>) {
+) -> (Vec<String>, BarSeries) {
     let all: Vec<&RunRow> = methods.iter().flat_map(|m| grid(rows, m, user)).collect();
     let categories: Vec<String> = stats::by(&all, key).into_iter().map(|(k, _)| k).collect();
     let series = methods
@@ -124,7 +130,7 @@ pub fn draw_all(
         let tag = slug(user);
         let cap = rows.iter().map(|r| r.cap).max().unwrap_or(30);
         let categories: Vec<String> = (0..=cap).map(|n| n.to_string()).collect();
-        let series: Vec<(String, Vec<Option<f64>>)> = methods
+        let series: BarSeries = methods
             .iter()
             .map(|method| {
                 let mut counts = vec![0usize; cap + 1];
@@ -153,7 +159,7 @@ pub fn draw_all(
             ),
             &|dir, stem| figures::save(dir, stem, (900, 450), &histogram).map(|_| ()),
         )?;
-        let sensitivity: [(&str, &str, &str, &dyn Fn(&RunRow) -> String); 3] = [
+        let sensitivity: [(&str, &str, &str, Key); 3] = [
             (
                 "fig08-style",
                 "Fig. 8: mean takeovers by driving style",

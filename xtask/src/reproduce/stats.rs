@@ -69,10 +69,7 @@ impl Summary {
 }
 
 /// Groups `rows` by `key`, in the order keys first appear, and summarizes each.
-pub fn by<'a, K: PartialEq + Clone>(
-    rows: &[&'a RunRow],
-    key: impl Fn(&RunRow) -> K,
-) -> Vec<(K, Summary)> {
+pub fn by<K: PartialEq + Clone>(rows: &[&RunRow], key: impl Fn(&RunRow) -> K) -> Vec<(K, Summary)> {
     let mut keys: Vec<K> = Vec::new();
     for row in rows {
         let k = key(row);
@@ -107,7 +104,7 @@ pub struct Transfer {
 }
 
 /// Pairs each transfer run of `rows` with the grid run of its cell.
-pub fn transfer<'a>(rows: &[&'a RunRow]) -> Transfer {
+pub fn transfer(rows: &[&RunRow]) -> Transfer {
     let grid: HashMap<CellKey, &RunRow> = rows
         .iter()
         .filter(|r| r.spec.experiment == Experiment::Grid)
@@ -163,7 +160,7 @@ pub struct Safety {
 }
 
 /// Perceived safety over `rows`.
-pub fn safety<'a>(rows: &[&'a RunRow]) -> Safety {
+pub fn safety(rows: &[&RunRow]) -> Safety {
     let longest = rows.iter().map(|r| r.iterations.len()).max().unwrap_or(0);
     let mean_by_iteration = (0..longest)
         .map(|i| {
