@@ -70,12 +70,16 @@ fn trend_cell(trend: &Trend) -> String {
     )
 }
 
+/// Means closer than this (takeovers) are reported as no difference: it is
+/// below the table's resolution of 0.1.
+const TREND_RESOLUTION: f64 = 0.05;
+
 fn trend_verdict(trend: &Trend) -> &'static str {
     match (trend.agrees(), trend.first.1, trend.second.1) {
-        (Some(true), ..) => "holds",
-        (Some(false), Some(a), Some(b)) if a == b => "no difference",
-        (Some(false), ..) => "reversed",
         (None, ..) => "not measured",
+        (_, Some(a), Some(b)) if (a - b).abs() < TREND_RESOLUTION => "no difference",
+        (Some(true), ..) => "holds",
+        (Some(false), ..) => "reversed",
     }
 }
 
@@ -458,6 +462,14 @@ fn user_section(out: &mut String, input: &ReportInput, user: &str) {
         );
     }
     let _ = writeln!(out);
+    if spread.is_some() {
+        let _ = writeln!(
+            out,
+            "A user with spread counts as personalized when the takeover rate is within the margin of \
+             the ceiling, so a personalized run may still end with takeovers: its last perceived-safety \
+             ratio need not be 1.\n"
+        );
+    }
     for (title, key) in [
         (
             "By style",
@@ -736,6 +748,17 @@ mod tests {
         assert!(report.contains(&format!("{refused} of {} runs were refused", rows.len())));
         assert!(report.contains("**This is the `--quick` subset**"));
         assert!(report.contains("| aggressive |"));
+    }
+
+    #[test]
+    fn a_trend_within_the_resolution_is_no_difference() {
+        let trend = |a, b| Trend {
+            first: ("a".into(), Some(a)),
+            second: ("b".into(), Some(b)),
+        };
+        assert_eq!(trend_verdict(&trend(2.10, 2.12)), "no difference");
+        assert_eq!(trend_verdict(&trend(2.0, 2.3)), "holds");
+        assert_eq!(trend_verdict(&trend(2.3, 2.0)), "reversed");
     }
 
     #[test]
