@@ -21,6 +21,8 @@ enum Command {
     Learn(commands::learn::LearnArgs),
     /// Background traffic on its own (IDM scenes, platoons).
     Traffic(commands::traffic::TrafficArgs),
+    /// Plan one lane change (the MPC as a QP) from a JSON problem.
+    Plan(commands::plan::PlanArgs),
     /// The perceived safe zone filter: fit on labelled samples, classify points.
     Zone(commands::zone::ZoneArgs),
 }
@@ -30,6 +32,7 @@ fn main() -> anyhow::Result<()> {
     match cli.command {
         Command::Learn(args) => commands::learn::run_learn(args),
         Command::Traffic(args) => commands::traffic::run(args),
+        Command::Plan(args) => commands::plan::run(args),
         Command::Zone(args) => commands::zone::run(args),
     }
 }

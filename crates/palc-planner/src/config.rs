@@ -46,9 +46,13 @@ pub struct SolverSettings {
     pub tol_gap_rel: f64,
     /// Primal and dual feasibility tolerance.
     pub tol_feas: f64,
-    /// Ruiz equilibration of the problem data before the first solve.
+    /// Ruiz equilibration of the problem data when the solver is built (kept while the
+    /// structure is reused). On by default: without it the optimum is measurably less
+    /// accurate (`s` is large next to `φ`), for a saving of about 0.2 ms at K = 120.
     pub equilibrate_enable: bool,
-    /// Iterative refinement of every KKT solve.
+    /// Iterative refinement of every KKT solve. Off by default: it tripled the time per
+    /// plan at K = 120 (7.3 ms vs 2.0 ms) with the same iteration count, and every
+    /// accuracy property test passes without it.
     pub iterative_refinement_enable: bool,
     /// Keep the solver (symbolic factorization, scaling) between plans with the same
     /// sparsity pattern and only overwrite the values.
@@ -63,7 +67,7 @@ impl Default for SolverSettings {
             tol_gap_rel: 1e-8,
             tol_feas: 1e-8,
             equilibrate_enable: true,
-            iterative_refinement_enable: true,
+            iterative_refinement_enable: false,
             reuse_structure: true,
         }
     }

@@ -1,0 +1,124 @@
+//! `palc plan --problem <file.json> [--out <file.json>]`: plan one lane change with the
+//! MPC of `palc-planner` (paper Eqs. 9-23) and write the trajectory as JSON.
+//!
+//! Input (JSON object; example: configs/examples/plan-problem.json):
+//! - `config`: the fields of `PlannerConfig`, each optional (defaults in brackets):
+//!   `horizon` K [60], `dt` s [0.1], `wheelbase` m [2.8], `acceleration_penalty` [1.0],
+//!   `steering_min`/`steering_max` rad [-0.5/0.5],
+//!   `lateral_bounds_mode`: `"hard"` or `{"soft": {"weight": w}}` [soft, 100],
+//!   `backend`: `"clarabel"`, `solver`: `{max_iter, tol_gap_abs, tol_gap_rel, tol_feas,
+//!   equilibrate_enable, iterative_refinement_enable, reuse_structure}`.
+//! - `problem`: `initial` `{s, v, l, phi}` (X_0, s relative to the ego's start is
+//!   recommended); `reference_speed` (K numbers, m/s); `curvature` (1/m, optional);
+//!   `weights` (K arrays of 10: column i-1 weighs stage i of Eq. 15);
+//!   `preceding`, `adjacent` (K objects `{s, l}`, steps 0..K-1);
+//!   `terminal` `{s (optional), v, l}` (phi_K = 0); `lateral_bounds` (K+1 entries, each
+//!   `null` or `{min, max}` with either side optional); `tracking` (optional,
+//!   `{weights: [q_s, q_v, q_l, q_phi], reference: K+1 entries of null or {s, v, l, phi}}`).
+//!
+//! Output (JSON object): `status` (`solved`, `almost_solved`, or on refusal `infeasible`,
+//! `non_convex`, `unbounded`, `solver_failed`, `invalid_input`); on success `states`
+//! (K+1), `controls` (K, `{a, delta}`), `objective` (= `learned_cost` + extras total),
+//! `learned_cost` (w · Φ), `extras` `{acceleration, tracking, lateral_slack}`,
+//! `features` (K arrays of 10, Eq. 34), `lateral_violation` (K+1), `stats`
+//! `{status, iterations, build_seconds, solve_seconds, structure_reused}`; on refusal
+//! `message`. A refusal also exits with an error after writing the output.
+
+use std::{
+    fs::File,
+    io::{BufReader, BufWriter, Write},
+    path::PathBuf,
+};
+
+use anyhow::{Context, bail};
+use clap::Args;
+use palc_planner::{Plan, PlanError, Planner, PlannerConfig, Problem, SolveStatus};
+use serde::{Deserialize, Serialize};
+
+/// Plan one lane change from a JSON problem.
+#[derive(Debug, Args)]
+pub struct PlanArgs {
+    /// The problem: JSON with `config` (PlannerConfig fields) and `problem` (see
+    /// configs/examples/plan-problem.json).
+    #[arg(long)]
+    problem: PathBuf,
+    /// Where to write the plan (JSON); stdout without it.
+    #[arg(long)]
+    out: Option<PathBuf>,
+}
+
+/// The input file.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PlanInput {
+    #[serde(default)]
+    config: PlannerConfig,
+    problem: Problem,
+}
+
+/// The output file.
+#[derive(Debug, Serialize)]
+struct PlanOutput {
+    status: &'static str,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    message: Option<String>,
+    #[serde(flatten, skip_serializing_if = "Option::is_none")]
+    plan: Option<Plan>,
+}
+
+fn refusal_status(error: &PlanError) -> &'static str {
+    match error {
+        PlanError::ZoneTooNarrow { .. }
+        | PlanError::BoundaryOutsideZone { .. }
+        | PlanError::Infeasible { .. } => "infeasible",
+        PlanError::NonConvex { .. } => "non_convex",
+        PlanError::Unbounded => "unbounded",
+        PlanError::SolverFailed { .. } => "solver_failed",
+        _ => "invalid_input",
+    }
+}
+
+/// Runs `palc plan`.
+pub fn run(args: PlanArgs) -> anyhow::Result<()> {
+    let path = &args.problem;
+    let file = File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
+    let input: PlanInput = serde_json::from_reader(BufReader::new(file))
+        .with_context(|| format!("cannot read the plan problem in {}", path.display()))?;
+    let result = Planner::new(input.config).and_then(|mut planner| planner.plan(&input.problem));
+    let output = match &result {
+        Ok(plan) => PlanOutput {
+            status: match plan.stats.status {
+                SolveStatus::Solved => "solved",
+                _ => "almost_solved",
+            },
+            message: None,
+            plan: Some(plan.clone()),
+        },
+        Err(error) => PlanOutput {
+            status: refusal_status(error),
+            message: Some(error.to_string()),
+            plan: None,
+        },
+    };
+    match &args.out {
+        Some(out) => {
+            let file =
+                File::create(out).with_context(|| format!("cannot create {}", out.display()))?;
+            let mut writer = BufWriter::new(file);
+            serde_json::to_writer_pretty(&mut writer, &output)
+                .map_err(std::io::Error::from)
+                .and_then(|()| writer.write_all(b"\n"))
+                .and_then(|()| writer.flush())
+                .with_context(|| format!("cannot write {}", out.display()))?;
+        }
+        None => {
+            let mut stdout = std::io::stdout().lock();
+            serde_json::to_writer_pretty(&mut stdout, &output)?;
+            writeln!(stdout)?;
+        }
+    }
+    if let Err(error) = result {
+        bail!("{}: {error}", path.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,113 @@
+//! Percentiles of the per-plan time (build + solve) over many plans, for the settings
+//! study in the crate docs: `cargo run --release -p palc-planner --example plan_latency`.
+//!
+//! Environment knobs (for measuring solver settings): `EQUILIBRATE=0`,
+//! `REFINE=0`, `REUSE=0`, `TOL=1e-6`.
+
+use std::time::Instant;
+
+use palc_planner::{
+    LateralBound, Planner, PlannerConfig, Position, Problem, SolverSettings, State, Terminal,
+    Weights,
+};
+
+fn problem(config: &PlannerConfig, speed: f64) -> Problem {
+    let k = config.horizon;
+    let dt = config.dt;
+    Problem {
+        initial: State {
+            s: 0.0,
+            v: speed,
+            l: 0.0,
+            phi: 0.0,
+        },
+        reference_speed: vec![speed; k],
+        curvature: 0.0,
+        weights: Weights::constant(k, [0.1, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 10.0, 1e-3, 1e-3]),
+        preceding: (0..k)
+            .map(|i| Position {
+                s: 30.0 + (speed - 2.0) * dt * i as f64,
+                l: 0.0,
+            })
+            .collect(),
+        adjacent: (0..k)
+            .map(|i| Position {
+                s: -20.0 + (speed + 2.0) * dt * i as f64,
+                l: 3.5,
+            })
+            .collect(),
+        terminal: Terminal {
+            s: None,
+            v: speed,
+            l: 3.5,
+        },
+        lateral_bounds: vec![Some(LateralBound::new(-1.75, 5.25)); k + 1],
+        tracking: None,
+    }
+}
+
+fn flag(name: &str) -> bool {
+    std::env::var(name).map_or(true, |v| v != "0")
+}
+
+fn main() {
+    let tol: f64 = std::env::var("TOL")
+        .ok()
+        .and_then(|t| t.parse().ok())
+        .unwrap_or(1e-8);
+    let solver = SolverSettings {
+        equilibrate_enable: flag("EQUILIBRATE"),
+        iterative_refinement_enable: flag("REFINE"),
+        reuse_structure: flag("REUSE"),
+        tol_gap_abs: tol,
+        tol_gap_rel: tol,
+        tol_feas: tol,
+        ..SolverSettings::default()
+    };
+    println!("{solver:?}");
+    println!(
+        "{:>4} {:>5} {:>9} {:>9} {:>6} {:>9} {:>9}",
+        "K", "dt", "p50 ms", "p99 ms", "iters", "build p50", "solve p50"
+    );
+    for dt in [0.1, 0.05] {
+        for k in [40, 60, 80, 120] {
+            let config = PlannerConfig {
+                horizon: k,
+                dt,
+                solver: solver.clone(),
+                ..PlannerConfig::default()
+            };
+            let problems: Vec<Problem> = [18.0, 20.0, 22.0, 26.0]
+                .iter()
+                .map(|&v| problem(&config, v))
+                .collect();
+            let mut planner = Planner::new(config).unwrap();
+            let mut times = Vec::new();
+            let mut builds = Vec::new();
+            let mut solves = Vec::new();
+            let mut iterations = 0;
+            for n in 0..600 {
+                let start = Instant::now();
+                let plan = planner.plan(&problems[n % problems.len()]).unwrap();
+                let elapsed = start.elapsed().as_secs_f64() * 1e3;
+                if n >= 100 {
+                    times.push(elapsed);
+                    builds.push(plan.stats.build_seconds * 1e3);
+                    solves.push(plan.stats.solve_seconds * 1e3);
+                    iterations = iterations.max(plan.stats.iterations);
+                }
+            }
+            let p = |v: &mut Vec<f64>, q: f64| {
+                v.sort_by(f64::total_cmp);
+                v[((v.len() - 1) as f64 * q).round() as usize]
+            };
+            println!(
+                "{k:>4} {dt:>5} {:>9.3} {:>9.3} {iterations:>6} {:>9.3} {:>9.3}",
+                p(&mut times, 0.5),
+                p(&mut times, 0.99),
+                p(&mut builds, 0.5),
+                p(&mut solves, 0.5)
+            );
+        }
+    }
+}
