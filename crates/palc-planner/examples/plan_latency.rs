@@ -1,8 +1,8 @@
 //! Percentiles of the per-plan time (build + solve) over many plans, for the settings
 //! study in the crate docs: `cargo run --release -p palc-planner --example plan_latency`.
 //!
-//! Environment knobs (for measuring solver settings): `EQUILIBRATE=0`,
-//! `REFINE=0`, `REUSE=0`, `TOL=1e-6`.
+//! Environment knobs (for measuring solver settings, unset = the defaults):
+//! `EQUILIBRATE=0|1`, `REFINE=0|1`, `REUSE=0|1`, `TOL=1e-6`.
 
 use std::time::Instant;
 
@@ -46,8 +46,8 @@ fn problem(config: &PlannerConfig, speed: f64) -> Problem {
     }
 }
 
-fn flag(name: &str) -> bool {
-    std::env::var(name).map_or(true, |v| v != "0")
+fn flag(name: &str, default: bool) -> bool {
+    std::env::var(name).map_or(default, |v| v != "0")
 }
 
 fn main() {
@@ -55,10 +55,11 @@ fn main() {
         .ok()
         .and_then(|t| t.parse().ok())
         .unwrap_or(1e-8);
+    let defaults = SolverSettings::default();
     let solver = SolverSettings {
-        equilibrate_enable: flag("EQUILIBRATE"),
-        iterative_refinement_enable: flag("REFINE"),
-        reuse_structure: flag("REUSE"),
+        equilibrate_enable: flag("EQUILIBRATE", defaults.equilibrate_enable),
+        iterative_refinement_enable: flag("REFINE", defaults.iterative_refinement_enable),
+        reuse_structure: flag("REUSE", defaults.reuse_structure),
         tol_gap_abs: tol,
         tol_gap_rel: tol,
         tol_feas: tol,
