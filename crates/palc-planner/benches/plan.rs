@@ -7,44 +7,11 @@
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use palc_planner::{
-    LateralBound, Planner, PlannerConfig, Position, Problem, State, Terminal, Weights,
-};
+use palc_planner::{Planner, PlannerConfig, Problem};
 
-fn problem(config: &PlannerConfig, speed: f64) -> Problem {
-    let k = config.horizon;
-    let dt = config.dt;
-    Problem {
-        initial: State {
-            s: 0.0,
-            v: speed,
-            l: 0.0,
-            phi: 0.0,
-        },
-        reference_speed: vec![speed; k],
-        curvature: 0.0,
-        weights: Weights::constant(k, [0.1, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 10.0, 1e-3, 1e-3]),
-        preceding: (0..k)
-            .map(|i| Position {
-                s: 30.0 + (speed - 2.0) * dt * i as f64,
-                l: 0.0,
-            })
-            .collect(),
-        adjacent: (0..k)
-            .map(|i| Position {
-                s: -20.0 + (speed + 2.0) * dt * i as f64,
-                l: 3.5,
-            })
-            .collect(),
-        terminal: Terminal {
-            s: None,
-            v: speed,
-            l: 3.5,
-        },
-        lateral_bounds: vec![Some(LateralBound::new(-1.75, 5.25)); k + 1],
-        tracking: None,
-    }
-}
+#[path = "../fixtures/lane_change.rs"]
+mod lane_change_fixture;
+use lane_change_fixture::lane_change as problem;
 
 fn bench_plan(c: &mut Criterion) {
     let mut group = c.benchmark_group("plan");

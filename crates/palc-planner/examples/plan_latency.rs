@@ -6,45 +6,11 @@
 
 use std::time::Instant;
 
-use palc_planner::{
-    LateralBound, Planner, PlannerConfig, Position, Problem, SolverSettings, State, Terminal,
-    Weights,
-};
+use palc_planner::{Planner, PlannerConfig, Problem, SolverSettings};
 
-fn problem(config: &PlannerConfig, speed: f64) -> Problem {
-    let k = config.horizon;
-    let dt = config.dt;
-    Problem {
-        initial: State {
-            s: 0.0,
-            v: speed,
-            l: 0.0,
-            phi: 0.0,
-        },
-        reference_speed: vec![speed; k],
-        curvature: 0.0,
-        weights: Weights::constant(k, [0.1, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 10.0, 1e-3, 1e-3]),
-        preceding: (0..k)
-            .map(|i| Position {
-                s: 30.0 + (speed - 2.0) * dt * i as f64,
-                l: 0.0,
-            })
-            .collect(),
-        adjacent: (0..k)
-            .map(|i| Position {
-                s: -20.0 + (speed + 2.0) * dt * i as f64,
-                l: 3.5,
-            })
-            .collect(),
-        terminal: Terminal {
-            s: None,
-            v: speed,
-            l: 3.5,
-        },
-        lateral_bounds: vec![Some(LateralBound::new(-1.75, 5.25)); k + 1],
-        tracking: None,
-    }
-}
+#[path = "../fixtures/lane_change.rs"]
+mod lane_change_fixture;
+use lane_change_fixture::lane_change as problem;
 
 fn flag(name: &str, default: bool) -> bool {
     std::env::var(name).map_or(default, |v| v != "0")

@@ -2,47 +2,13 @@
 #![allow(dead_code)]
 
 use palc_planner::{
-    Control, LateralBound, LateralBoundsMode, PlannerConfig, Position, Problem, State, Terminal,
-    Weights, features,
+    Control, LateralBound, LateralBoundsMode, PlannerConfig, Problem, State, Weights, features,
 };
 use proptest::prelude::*;
 
-/// A plausible lane change at `speed` from lane 0 to lane 1, slower preceding vehicle
-/// 30 m ahead, adjacent vehicle 20 m behind on the target lane, road-edge bounds.
-pub fn lane_change(config: &PlannerConfig, speed: f64) -> Problem {
-    let k = config.horizon;
-    let dt = config.dt;
-    Problem {
-        initial: State {
-            s: 0.0,
-            v: speed,
-            l: 0.0,
-            phi: 0.0,
-        },
-        reference_speed: vec![speed; k],
-        curvature: 0.0,
-        weights: Weights::constant(k, [0.1, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 10.0, 1e-3, 1e-3]),
-        preceding: (0..k)
-            .map(|i| Position {
-                s: 30.0 + (speed - 2.0) * dt * i as f64,
-                l: 0.0,
-            })
-            .collect(),
-        adjacent: (0..k)
-            .map(|i| Position {
-                s: -20.0 + (speed + 2.0) * dt * i as f64,
-                l: 3.5,
-            })
-            .collect(),
-        terminal: Terminal {
-            s: None,
-            v: speed,
-            l: 3.5,
-        },
-        lateral_bounds: vec![Some(LateralBound::new(-1.75, 5.25)); k + 1],
-        tracking: None,
-    }
-}
+#[path = "../../fixtures/lane_change.rs"]
+mod lane_change_fixture;
+pub use lane_change_fixture::lane_change;
 
 /// Random weights in the convex set: every stage block is PSD by construction
 /// (couplings at most 90 % of what each diagonal can carry against a third of w8).
