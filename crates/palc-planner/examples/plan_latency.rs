@@ -2,11 +2,12 @@
 //! study in the crate docs: `cargo run --release -p palc-planner --example plan_latency`.
 //!
 //! Environment knobs (for measuring solver settings, unset = the defaults):
+//! `BACKEND=riccati|clarabel`, `HARD=0|1` (hard lateral bounds),
 //! `EQUILIBRATE=0|1`, `REFINE=0|1`, `REUSE=0|1`, `TOL=1e-6`.
 
 use std::time::Instant;
 
-use palc_planner::{Planner, PlannerConfig, Problem, SolverSettings};
+use palc_planner::{Backend, LateralBoundsMode, Planner, PlannerConfig, Problem, SolverSettings};
 
 #[path = "../fixtures/lane_change.rs"]
 mod lane_change_fixture;
@@ -31,7 +32,17 @@ fn main() {
         tol_feas: tol,
         ..SolverSettings::default()
     };
-    println!("{solver:?}");
+    let backend = match std::env::var("BACKEND").as_deref() {
+        Ok("clarabel") => Backend::Clarabel,
+        Ok("riccati") => Backend::Riccati,
+        _ => PlannerConfig::default().backend,
+    };
+    let lateral_bounds_mode = if flag("HARD", false) {
+        LateralBoundsMode::Hard
+    } else {
+        PlannerConfig::default().lateral_bounds_mode
+    };
+    println!("{backend:?} {lateral_bounds_mode:?} {solver:?}");
     println!(
         "{:>4} {:>5} {:>9} {:>9} {:>6} {:>9} {:>9}",
         "K", "dt", "p50 ms", "p99 ms", "iters", "build p50", "solve p50"
@@ -42,6 +53,8 @@ fn main() {
                 horizon: k,
                 dt,
                 solver: solver.clone(),
+                backend,
+                lateral_bounds_mode,
                 ..PlannerConfig::default()
             };
             let problems: Vec<Problem> = [18.0, 20.0, 22.0, 26.0]

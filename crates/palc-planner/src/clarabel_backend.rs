@@ -4,19 +4,9 @@
 use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 
+use crate::backend::{RawSolution, RawStatus};
 use crate::qp::{CscPattern, Pattern, QpData};
 use crate::{PlanError, SolverSettings};
-
-/// Raw result of one solve.
-pub(crate) struct RawSolution {
-    pub status: SolverStatus,
-    pub iterations: u32,
-    pub x: Vec<f64>,
-    pub z: Vec<f64>,
-    pub reused: bool,
-    pub setup_seconds: f64,
-    pub solve_seconds: f64,
-}
 
 struct Cached {
     pattern: Pattern,
@@ -131,8 +121,19 @@ impl ClarabelBackend {
         cached.solver.solve();
         let solve_seconds = start.elapsed().as_secs_f64();
         let solution = &cached.solver.solution;
+        let status = match solution.status {
+            SolverStatus::Solved => RawStatus::Solved,
+            SolverStatus::AlmostSolved => RawStatus::AlmostSolved,
+            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
+                RawStatus::PrimalInfeasible
+            }
+            SolverStatus::DualInfeasible | SolverStatus::AlmostDualInfeasible => {
+                RawStatus::DualInfeasible
+            }
+            other => RawStatus::Failed(format!("{other:?}")),
+        };
         Ok(RawSolution {
-            status: solution.status,
+            status,
             iterations: solution.iterations,
             x: solution.x.clone(),
             z: solution.z.clone(),

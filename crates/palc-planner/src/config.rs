@@ -22,13 +22,19 @@ pub enum LateralBoundsMode {
     },
 }
 
-/// The QP backend. Only clarabel exists today; a Riccati-based interior-point
-/// backend can be added behind the same API.
+/// The QP backend. Both solve the same assembled QP and return the same [`Plan`](crate::Plan)
+/// and [`PlanError`](crate::PlanError)s.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 #[non_exhaustive]
 pub enum Backend {
-    /// The sparse interior-point solver of the `clarabel` crate.
+    /// A Mehrotra predictor-corrector interior point whose Newton systems are solved by
+    /// a time-varying Riccati recursion over the stages (fixed-size 4 x 4 and 2 x 2
+    /// blocks, no allocation inside the iterations). It reads the tolerances and
+    /// `max_iter` of [`SolverSettings`]; the other settings are clarabel's.
+    Riccati,
+    /// The general sparse interior-point solver of the `clarabel` crate, kept as the
+    /// reference.
     #[default]
     Clarabel,
 }

@@ -48,6 +48,7 @@
 //! ```
 #![warn(missing_docs)]
 
+mod backend;
 mod clarabel_backend;
 mod config;
 mod convexity;
@@ -56,6 +57,7 @@ mod features;
 mod planner;
 mod problem;
 mod qp;
+mod riccati;
 mod validate;
 mod weights;
 

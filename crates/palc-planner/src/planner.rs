@@ -1,10 +1,11 @@
 //! The planner: validation, QP assembly, solve, and the plan with its features.
 
-use clarabel::solver::SolverStatus;
 use serde::{Deserialize, Serialize};
 
+use crate::backend::RawStatus;
 use crate::clarabel_backend::ClarabelBackend;
 use crate::qp::{QpData, RowTag, control_index, pattern_of, state_index};
+use crate::riccati::RiccatiBackend;
 use crate::validate::validate_problem;
 use crate::{
     Backend, Control, Features, LateralBoundsMode, PlanError, PlannerConfig, Problem, State,
@@ -84,17 +85,18 @@ pub struct Planner {
     config: PlannerConfig,
     data: QpData,
     clarabel: ClarabelBackend,
+    riccati: RiccatiBackend,
 }
 
 impl Planner {
     /// A planner for a validated configuration.
     pub fn new(config: PlannerConfig) -> Result<Self, PlanError> {
         config.validate()?;
-        let Backend::Clarabel = config.backend;
         Ok(Self {
             config,
             data: QpData::default(),
             clarabel: ClarabelBackend::default(),
+            riccati: RiccatiBackend::default(),
         })
     }
 
@@ -110,21 +112,26 @@ impl Planner {
         validate_problem(&self.config, problem)?;
         self.data.assemble(&self.config, problem);
         let assembled = start.elapsed().as_secs_f64();
-        let raw = self
-            .clarabel
-            .solve(&self.data, pattern_of(problem), &self.config.solver)?;
+        let pattern = pattern_of(problem);
+        let raw = match self.config.backend {
+            Backend::Riccati => self.riccati.solve(
+                &self.data,
+                pattern,
+                self.config.horizon,
+                &self.config.solver,
+            )?,
+            Backend::Clarabel => self
+                .clarabel
+                .solve(&self.data, pattern, &self.config.solver)?,
+        };
         let status = match raw.status {
-            SolverStatus::Solved => SolveStatus::Solved,
-            SolverStatus::AlmostSolved => SolveStatus::AlmostSolved,
-            SolverStatus::PrimalInfeasible | SolverStatus::AlmostPrimalInfeasible => {
-                return Err(self.infeasible(&raw.z));
-            }
-            SolverStatus::DualInfeasible | SolverStatus::AlmostDualInfeasible => {
-                return Err(PlanError::Unbounded);
-            }
-            other => {
+            RawStatus::Solved => SolveStatus::Solved,
+            RawStatus::AlmostSolved => SolveStatus::AlmostSolved,
+            RawStatus::PrimalInfeasible => return Err(self.infeasible(&raw.z)),
+            RawStatus::DualInfeasible => return Err(PlanError::Unbounded),
+            RawStatus::Failed(status) => {
                 return Err(PlanError::SolverFailed {
-                    status: format!("{other:?}"),
+                    status,
                     iterations: raw.iterations,
                 });
             }

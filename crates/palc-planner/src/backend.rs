@@ -1,0 +1,31 @@
+//! What every QP backend returns to the planner.
+
+/// How a backend finished, in backend-neutral terms.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum RawStatus {
+    /// Solved to the requested tolerances.
+    Solved,
+    /// Solved to reduced tolerances only.
+    AlmostSolved,
+    /// A certificate of primal infeasibility was found (in `RawSolution::z`).
+    PrimalInfeasible,
+    /// A certificate of dual infeasibility (an unbounded direction) was found.
+    DualInfeasible,
+    /// Stopped without a solution; the string names the reason.
+    Failed(String),
+}
+
+/// Raw result of one solve, in the variable and row order of [`QpData`](crate::qp::QpData).
+#[derive(Debug, Clone)]
+pub(crate) struct RawSolution {
+    pub status: RawStatus,
+    pub iterations: u32,
+    /// Primal variables `z` of the QP.
+    pub x: Vec<f64>,
+    /// Multipliers of all rows, equality rows first (length `m_eq + m_in`); on primal
+    /// infeasibility, the certificate.
+    pub z: Vec<f64>,
+    pub reused: bool,
+    pub setup_seconds: f64,
+    pub solve_seconds: f64,
+}

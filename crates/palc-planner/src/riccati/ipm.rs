@@ -1,0 +1,553 @@
+//! Mehrotra predictor-corrector primal-dual interior point on the stage QP
+//!
+//! ```text
+//! min ½ zᵀPz + qᵀz   s.t.   A z = b (X_0, dynamics, terminal),   G z + s = h,  s >= 0,
+//! ```
+//!
+//! with multipliers `y` (equalities) and `λ >= 0` (inequalities). Each Newton system
+//! eliminates `s` and `λ` (`W = λ / s`), then each soft-bound slack `σ` (a scalar tied to
+//! one lateral position), and hands the remaining stage QP to the [`Riccati`]
+//! recursion: one factorization and two solves (predictor, corrector) per iteration.
+//!
+//! The start is Mehrotra's: the Newton system with `W = I` at `z = 0`, then `s` and `λ`
+//! shifted into the positive orthant. The stopping rule uses clarabel's measures on
+//! the unscaled data (relative primal and dual residuals, absolute or relative gap).
+//! A primal infeasibility certificate `(y, λ)` with `Aᵀy + Gᵀλ = 0`, `bᵀy + hᵀλ < 0`
+//! is checked at every iterate; when the constraints are inconsistent the multipliers
+//! of an infeasible-start method grow along such a ray.
+
+use nalgebra::{Matrix6, Vector4, Vector6};
+
+use super::recursion::{FactorError, Rhs, Riccati, Step};
+use super::stage_qp::{NX, StageQp};
+
+/// Relative tolerance of the infeasibility certificate: `‖Aᵀy + Gᵀλ‖∞ <= TOL · -(bᵀy + hᵀλ)`.
+/// A feasible problem can pass it only if its solutions have `‖z‖₁ >= 1 / TOL`.
+const INFEASIBILITY_TOLERANCE: f64 = 1e-9;
+/// clarabel's reduced tolerances, used for `AlmostSolved`.
+const REDUCED_GAP: f64 = 5e-5;
+const REDUCED_FEAS: f64 = 1e-4;
+/// Fraction of the step to the boundary of the positive orthant.
+const STEP_FRACTION: f64 = 0.99;
+
+/// Stopping tolerances (from [`SolverSettings`](crate::SolverSettings)).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Tolerances {
+    pub max_iter: u32,
+    pub gap_abs: f64,
+    pub gap_rel: f64,
+    pub feas: f64,
+}
+
+/// How the interior point ended.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Outcome {
+    Solved,
+    AlmostSolved,
+    PrimalInfeasible,
+    Failed(String),
+}
+
+/// Convergence measures of one iterate.
+#[derive(Debug, Clone, Copy)]
+struct Measures {
+    res_primal: f64,
+    res_dual: f64,
+    gap_abs: f64,
+    gap_rel: f64,
+    /// `bᵀy + hᵀλ` and `‖Aᵀy + Gᵀλ‖∞`.
+    certificate_value: f64,
+    certificate_residual: f64,
+}
+
+impl Measures {
+    fn meets(&self, gap_abs: f64, gap_rel: f64, feas: f64) -> bool {
+        (self.gap_abs < gap_abs || self.gap_rel < gap_rel)
+            && self.res_primal < feas
+            && self.res_dual < feas
+    }
+
+    fn infeasible(&self) -> bool {
+        self.certificate_value < 0.0
+            && self.certificate_residual <= INFEASIBILITY_TOLERANCE * -self.certificate_value
+    }
+}
+
+fn norm_inf<'a>(values: impl IntoIterator<Item = &'a f64>) -> f64 {
+    values.into_iter().fold(0.0_f64, |m, v| m.max(v.abs()))
+}
+
+/// The iterate, the residuals and every buffer of the Newton systems.
+#[derive(Debug, Default)]
+pub(crate) struct Ipm {
+    // Iterate: stage variables, slacks, multipliers, inequality slacks and duals.
+    pub z: Vec<Vector6<f64>>,
+    pub sigma: Vec<f64>,
+    pub y_initial: Vector4<f64>,
+    pub y_dynamics: Vec<Vector4<f64>>,
+    pub y_terminal: Vector4<f64>,
+    pub s: Vec<f64>,
+    pub lambda: Vec<f64>,
+    pub iterations: u32,
+    // Residuals.
+    pz: Vec<Vector6<f64>>,
+    r_dual: Vec<Vector6<f64>>,
+    r_dual_sigma: Vec<f64>,
+    r_initial: Vector4<f64>,
+    r_dynamics: Vec<Vector4<f64>>,
+    r_terminal: Vector4<f64>,
+    r_in: Vec<f64>,
+    // Newton system.
+    w: Vec<f64>,
+    xi: Vec<f64>,
+    rc: Vec<f64>,
+    newton_h: Vec<Matrix6<f64>>,
+    h_ss: Vec<f64>,
+    h_sv: Vec<f64>,
+    g: Vec<Vector6<f64>>,
+    g_sigma: Vec<f64>,
+    offsets: Vec<Vector4<f64>>,
+    // Newton step.
+    dz: Vec<Vector6<f64>>,
+    d_sigma: Vec<f64>,
+    ds: Vec<f64>,
+    d_lambda: Vec<f64>,
+    ds_affine: Vec<f64>,
+    d_lambda_affine: Vec<f64>,
+    y_initial_new: Vector4<f64>,
+    y_dynamics_new: Vec<Vector4<f64>>,
+    y_terminal_new: Vector4<f64>,
+    riccati: Riccati,
+    // Data norms.
+    norm_b: f64,
+    norm_q: f64,
+}
+
+impl Ipm {
+    /// Sizes every buffer for `qp` (the only allocation of a solve).
+    pub fn resize(&mut self, qp: &StageQp) {
+        let (k, n_slack, m_in) = (qp.k, qp.slack_cost.len(), qp.inequalities.len());
+        for v in [
+            &mut self.z,
+            &mut self.pz,
+            &mut self.r_dual,
+            &mut self.g,
+            &mut self.dz,
+        ] {
+            v.clear();
+            v.resize(k + 1, Vector6::zeros());
+        }
+        for v in [
+            &mut self.y_dynamics,
+            &mut self.r_dynamics,
+            &mut self.offsets,
+            &mut self.y_dynamics_new,
+        ] {
+            v.clear();
+            v.resize(k, Vector4::zeros());
+        }
+        for v in [
+            &mut self.sigma,
+            &mut self.r_dual_sigma,
+            &mut self.h_ss,
+            &mut self.h_sv,
+            &mut self.g_sigma,
+            &mut self.d_sigma,
+        ] {
+            v.clear();
+            v.resize(n_slack, 0.0);
+        }
+        for v in [
+            &mut self.s,
+            &mut self.lambda,
+            &mut self.r_in,
+            &mut self.w,
+            &mut self.xi,
+            &mut self.rc,
+            &mut self.ds,
+            &mut self.d_lambda,
+            &mut self.ds_affine,
+            &mut self.d_lambda_affine,
+        ] {
+            v.clear();
+            v.resize(m_in, 0.0);
+        }
+        self.newton_h.clear();
+        self.newton_h.resize(k + 1, Matrix6::zeros());
+        self.riccati.resize(k);
+        self.y_initial = Vector4::zeros();
+        self.y_terminal = Vector4::zeros();
+        self.iterations = 0;
+        let m = qp.terminal_rows;
+        self.norm_b = norm_inf(qp.x0.iter())
+            .max(qp.dynamics.iter().fold(0.0, |n, d| n.max(d.c.amax())))
+            .max(norm_inf(qp.terminal_rhs.iter().take(m)))
+            .max(norm_inf(qp.inequalities.iter().map(|r| &r.h)));
+        self.norm_q = qp
+            .linear
+            .iter()
+            .fold(0.0_f64, |n, g| n.max(g.amax()))
+            .max(norm_inf(&qp.slack_cost));
+    }
+
+    /// Runs the interior point from Mehrotra's start; the iterate holds the result.
+    pub fn run(&mut self, qp: &StageQp, tol: &Tolerances) -> Outcome {
+        if let Err(e) = self.start(qp) {
+            return failed(e);
+        }
+        let mut stalled = 0;
+        loop {
+            let measures = self.residuals(qp);
+            if measures.meets(tol.gap_abs, tol.gap_rel, tol.feas) {
+                return Outcome::Solved;
+            }
+            if measures.infeasible() {
+                return Outcome::PrimalInfeasible;
+            }
+            if self.iterations >= tol.max_iter || stalled >= 3 {
+                if measures.meets(REDUCED_GAP, REDUCED_GAP, REDUCED_FEAS) {
+                    return Outcome::AlmostSolved;
+                }
+                return Outcome::Failed(if stalled >= 3 {
+                    "InsufficientProgress".into()
+                } else {
+                    "MaxIterations".into()
+                });
+            }
+            self.iterations += 1;
+            match self.iterate(qp) {
+                Ok(alpha) if alpha < 1e-8 => stalled += 1,
+                Ok(_) => stalled = 0,
+                Err(e) => return failed(e),
+            }
+        }
+    }
+
+    /// Mehrotra's starting point.
+    fn start(&mut self, qp: &StageQp) -> Result<(), FactorError> {
+        self.residuals(qp);
+        self.w.fill(1.0);
+        self.factor(qp)?;
+        for (xi, row) in self.xi.iter_mut().zip(&qp.inequalities) {
+            *xi = -row.h;
+        }
+        self.newton_step(qp);
+        self.z.copy_from_slice(&self.dz);
+        self.sigma.copy_from_slice(&self.d_sigma);
+        self.y_initial = self.y_initial_new;
+        self.y_dynamics.copy_from_slice(&self.y_dynamics_new);
+        self.y_terminal = self.y_terminal_new;
+        // ds = h - G z; s = h - G z and λ = G z - h, shifted into the orthant.
+        for j in 0..self.s.len() {
+            self.s[j] = self.ds[j];
+            self.lambda[j] = -self.ds[j];
+        }
+        let shift = |v: &mut [f64]| {
+            let min = v.iter().copied().fold(f64::INFINITY, f64::min);
+            let delta = (-1.5 * min).max(0.0);
+            v.iter_mut().for_each(|x| *x += delta);
+        };
+        shift(&mut self.s);
+        shift(&mut self.lambda);
+        let sl: f64 = self.s.iter().zip(&self.lambda).map(|(s, l)| s * l).sum();
+        let (sum_s, sum_l) = (self.s.iter().sum::<f64>(), self.lambda.iter().sum::<f64>());
+        if sl > 1e-8 * self.s.len() as f64 && sum_s > 0.0 && sum_l > 0.0 {
+            let (ds, dl) = (0.5 * sl / sum_l, 0.5 * sl / sum_s);
+            self.s.iter_mut().for_each(|x| *x += ds);
+            self.lambda.iter_mut().for_each(|x| *x += dl);
+        } else {
+            self.s.iter_mut().for_each(|x| *x += 1.0);
+            self.lambda.iter_mut().for_each(|x| *x += 1.0);
+        }
+        Ok(())
+    }
+
+    /// One predictor-corrector iteration; returns the step length.
+    fn iterate(&mut self, qp: &StageQp) -> Result<f64, FactorError> {
+        let m_in = self.s.len() as f64;
+        let mu = self
+            .s
+            .iter()
+            .zip(&self.lambda)
+            .map(|(s, l)| s * l)
+            .sum::<f64>()
+            / m_in;
+        for j in 0..self.s.len() {
+            self.w[j] = self.lambda[j] / self.s[j];
+        }
+        self.factor(qp)?;
+
+        // Predictor: r_c = s∘λ, so ξ = λ + W r_in - r_c / s = W r_in.
+        for j in 0..self.s.len() {
+            self.rc[j] = self.s[j] * self.lambda[j];
+            self.xi[j] = self.w[j] * self.r_in[j];
+        }
+        self.newton_step(qp);
+        self.dual_step();
+        let alpha = self.step_to_boundary();
+        let mu_affine = self
+            .s
+            .iter()
+            .zip(&self.ds)
+            .zip(self.lambda.iter().zip(&self.d_lambda))
+            .map(|((s, ds), (l, dl))| (s + alpha * ds) * (l + alpha * dl))
+            .sum::<f64>()
+            / m_in;
+        let centering = (mu_affine / mu).clamp(0.0, 1.0).powi(3);
+        self.ds_affine.copy_from_slice(&self.ds);
+        self.d_lambda_affine.copy_from_slice(&self.d_lambda);
+
+        // Corrector with centring.
+        for j in 0..self.s.len() {
+            self.rc[j] = self.s[j] * self.lambda[j] + self.ds_affine[j] * self.d_lambda_affine[j]
+                - centering * mu;
+            self.xi[j] = self.lambda[j] + self.w[j] * self.r_in[j] - self.rc[j] / self.s[j];
+        }
+        self.newton_step(qp);
+        self.dual_step();
+        let alpha = (STEP_FRACTION * self.step_to_boundary()).min(1.0);
+
+        for i in 0..self.z.len() {
+            self.z[i] += alpha * self.dz[i];
+        }
+        for j in 0..self.sigma.len() {
+            self.sigma[j] += alpha * self.d_sigma[j];
+        }
+        for j in 0..self.s.len() {
+            self.s[j] += alpha * self.ds[j];
+            self.lambda[j] += alpha * self.d_lambda[j];
+        }
+        self.y_initial += alpha * (self.y_initial_new - self.y_initial);
+        for i in 0..self.y_dynamics.len() {
+            let step = alpha * (self.y_dynamics_new[i] - self.y_dynamics[i]);
+            self.y_dynamics[i] += step;
+        }
+        self.y_terminal += alpha * (self.y_terminal_new - self.y_terminal);
+        Ok(alpha)
+    }
+
+    /// `Δλ = -r_c / s - W Δs`.
+    fn dual_step(&mut self) {
+        for j in 0..self.s.len() {
+            self.d_lambda[j] = -self.rc[j] / self.s[j] - self.w[j] * self.ds[j];
+        }
+    }
+
+    /// The largest `α <= 1` with `s + α Δs >= 0` and `λ + α Δλ >= 0`.
+    fn step_to_boundary(&self) -> f64 {
+        let mut alpha = 1.0_f64;
+        for j in 0..self.s.len() {
+            if self.ds[j] < 0.0 {
+                alpha = alpha.min(-self.s[j] / self.ds[j]);
+            }
+            if self.d_lambda[j] < 0.0 {
+                alpha = alpha.min(-self.lambda[j] / self.d_lambda[j]);
+            }
+        }
+        alpha
+    }
+
+    /// `P + Gᵀ W G` in stage form, the slacks eliminated, and its Riccati factorization.
+    fn factor(&mut self, qp: &StageQp) -> Result<(), FactorError> {
+        self.newton_h.copy_from_slice(&qp.hessian);
+        self.h_ss.fill(0.0);
+        self.h_sv.fill(0.0);
+        for (row, &w) in qp.inequalities.iter().zip(&self.w) {
+            if let Some((i, l)) = row.core {
+                self.newton_h[i][(l, l)] += w * row.coef * row.coef;
+            }
+            if let Some(j) = row.slack {
+                self.h_ss[j] += w * row.slack_coef * row.slack_coef;
+                if row.core.is_some() {
+                    self.h_sv[j] += w * row.coef * row.slack_coef;
+                }
+            }
+        }
+        for (j, core) in qp.slack_core.iter().enumerate() {
+            if let Some((i, l)) = *core {
+                self.newton_h[i][(l, l)] -= self.h_sv[j] * self.h_sv[j] / self.h_ss[j];
+            }
+        }
+        self.riccati
+            .factor(&self.newton_h, &qp.dynamics, &qp.terminal, qp.terminal_rows)
+    }
+
+    /// Solves the factored Newton system for the current `ξ` and residuals:
+    /// `(P + GᵀWG) Δz + Aᵀ y⁺ = -(Pz + q + Gᵀξ)`, `A Δz = -r_eq`, then `Δs = -r_in - G Δz`.
+    fn newton_step(&mut self, qp: &StageQp) {
+        for i in 0..self.g.len() {
+            self.g[i] = self.pz[i] + qp.linear[i];
+        }
+        self.g_sigma.copy_from_slice(&qp.slack_cost);
+        for (row, &xi) in qp.inequalities.iter().zip(&self.xi) {
+            if let Some((i, l)) = row.core {
+                self.g[i][l] += row.coef * xi;
+            }
+            if let Some(j) = row.slack {
+                self.g_sigma[j] += row.slack_coef * xi;
+            }
+        }
+        for (j, core) in qp.slack_core.iter().enumerate() {
+            if let Some((i, l)) = *core {
+                self.g[i][l] -= self.h_sv[j] * self.g_sigma[j] / self.h_ss[j];
+            }
+        }
+        for (offset, r) in self.offsets.iter_mut().zip(&self.r_dynamics) {
+            *offset = -r;
+        }
+        let rhs = Rhs {
+            linear: &self.g,
+            offsets: &self.offsets,
+            initial: -self.r_initial,
+            terminal: -self.r_terminal,
+        };
+        self.riccati.solve(
+            &qp.dynamics,
+            &rhs,
+            Step {
+                z: &mut self.dz,
+                y_dynamics: &mut self.y_dynamics_new,
+                y_initial: &mut self.y_initial_new,
+                y_terminal: &mut self.y_terminal_new,
+            },
+        );
+        for (j, core) in qp.slack_core.iter().enumerate() {
+            let coupled = core.map_or(0.0, |(i, l)| self.h_sv[j] * self.dz[i][l]);
+            self.d_sigma[j] = -(self.g_sigma[j] + coupled) / self.h_ss[j];
+        }
+        for (j, row) in qp.inequalities.iter().enumerate() {
+            let gz = row.core.map_or(0.0, |(i, l)| row.coef * self.dz[i][l])
+                + row.slack.map_or(0.0, |k| row.slack_coef * self.d_sigma[k]);
+            self.ds[j] = -self.r_in[j] - gz;
+        }
+    }
+
+    /// Residuals and convergence measures of the current iterate.
+    fn residuals(&mut self, qp: &StageQp) -> Measures {
+        let k = qp.k;
+        let m = qp.terminal_rows;
+        // Aᵀy + Gᵀλ into r_dual (stage part) and r_dual_sigma.
+        for v in self.r_dual.iter_mut() {
+            *v = Vector6::zeros();
+        }
+        self.r_dual_sigma.fill(0.0);
+        head(&mut self.r_dual[0], &self.y_initial);
+        for i in 0..k {
+            let d = &qp.dynamics[i];
+            let y = &self.y_dynamics[i];
+            head(&mut self.r_dual[i + 1], y);
+            head(&mut self.r_dual[i], &-d.a.tr_mul(y));
+            let mut tail = self.r_dual[i].fixed_rows_mut::<2>(4);
+            tail -= d.b.tr_mul(y);
+        }
+        head(&mut self.r_dual[k], &qp.terminal.tr_mul(&self.y_terminal));
+        for (row, &l) in qp.inequalities.iter().zip(&self.lambda) {
+            if let Some((i, c)) = row.core {
+                self.r_dual[i][c] += row.coef * l;
+            }
+            if let Some(j) = row.slack {
+                self.r_dual_sigma[j] += row.slack_coef * l;
+            }
+        }
+        let certificate_residual = self
+            .r_dual
+            .iter()
+            .fold(0.0_f64, |n, v| n.max(v.amax()))
+            .max(norm_inf(&self.r_dual_sigma));
+        let mut by = qp.x0.dot(&self.y_initial);
+        for i in 0..k {
+            by += qp.dynamics[i].c.dot(&self.y_dynamics[i]);
+        }
+        for j in 0..m {
+            by += qp.terminal_rhs[j] * self.y_terminal[j];
+        }
+        let hl: f64 = qp
+            .inequalities
+            .iter()
+            .zip(&self.lambda)
+            .map(|(r, l)| r.h * l)
+            .sum();
+
+        // Dual residual Pz + q + Aᵀy + Gᵀλ and the objectives.
+        let mut xpx = 0.0;
+        let mut qx = 0.0;
+        for i in 0..=k {
+            self.pz[i] = qp.hessian[i] * self.z[i];
+            xpx += self.z[i].dot(&self.pz[i]);
+            qx += qp.linear[i].dot(&self.z[i]);
+            self.r_dual[i] += self.pz[i] + qp.linear[i];
+        }
+        for j in 0..self.sigma.len() {
+            qx += qp.slack_cost[j] * self.sigma[j];
+            self.r_dual_sigma[j] += qp.slack_cost[j];
+        }
+
+        // Primal residuals.
+        self.r_initial = self.z[0].fixed_rows::<4>(0) - qp.x0;
+        for i in 0..k {
+            let d = &qp.dynamics[i];
+            let x = self.z[i].fixed_rows::<4>(0);
+            let u = self.z[i].fixed_rows::<2>(4);
+            self.r_dynamics[i] = self.z[i + 1].fixed_rows::<4>(0) - d.a * x - d.b * u - d.c;
+        }
+        self.r_terminal = qp.terminal * self.z[k].fixed_rows::<4>(0) - qp.terminal_rhs;
+        for j in m..NX {
+            self.r_terminal[j] = 0.0;
+        }
+        for (j, row) in qp.inequalities.iter().enumerate() {
+            let gz = row.core.map_or(0.0, |(i, l)| row.coef * self.z[i][l])
+                + row.slack.map_or(0.0, |k| row.slack_coef * self.sigma[k]);
+            self.r_in[j] = gz + self.s[j] - row.h;
+        }
+
+        let norm_z = self
+            .z
+            .iter()
+            .fold(0.0_f64, |n, v| n.max(v.amax()))
+            .max(norm_inf(&self.sigma));
+        let norm_s = norm_inf(&self.s);
+        let norm_y = self
+            .y_dynamics
+            .iter()
+            .fold(self.y_initial.amax().max(self.y_terminal.amax()), |n, v| {
+                n.max(v.amax())
+            })
+            .max(norm_inf(&self.lambda));
+        let primal = self
+            .r_dynamics
+            .iter()
+            .fold(self.r_initial.amax().max(self.r_terminal.amax()), |n, v| {
+                n.max(v.amax())
+            })
+            .max(norm_inf(&self.r_in));
+        let dual = self
+            .r_dual
+            .iter()
+            .fold(0.0_f64, |n, v| n.max(v.amax()))
+            .max(norm_inf(&self.r_dual_sigma));
+        let pobj = 0.5 * xpx + qx;
+        let dobj = -0.5 * xpx - by - hl;
+        let gap_abs = (pobj - dobj).abs();
+        Measures {
+            res_primal: primal / (self.norm_b + norm_z + norm_s).max(1.0),
+            res_dual: dual / (self.norm_q + norm_z + norm_y).max(1.0),
+            gap_abs,
+            gap_rel: gap_abs / pobj.abs().min(dobj.abs()).max(1.0),
+            certificate_value: by + hl,
+            certificate_residual,
+        }
+    }
+}
+
+/// Adds `add` to the state part of `v`.
+fn head(v: &mut Vector6<f64>, add: &Vector4<f64>) {
+    let mut h = v.fixed_rows_mut::<4>(0);
+    h += add;
+}
+
+fn failed(e: FactorError) -> Outcome {
+    Outcome::Failed(match e {
+        FactorError::ControlBlock(i) => format!("control block of step {i} not positive definite"),
+        FactorError::Terminal => "terminal Schur complement not positive definite".into(),
+    })
+}

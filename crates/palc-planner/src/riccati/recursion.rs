@@ -1,0 +1,189 @@
+//! The time-varying Riccati recursion that solves one Newton system of the interior
+//! point: the equality-constrained stage QP
+//!
+//! ```text
+//! min Σ_{i<K} ½ [x_i; u_i]ᵀ H_i [x_i; u_i] + g_iᵀ [x_i; u_i] + ½ x_Kᵀ H_K x_K + g_Kᵀ x_K
+//! s.t. x_0 = x̂_0,  x_{i+1} = A_i x_i + B_i u_i + f_i,  E x_K = e.
+//! ```
+//!
+//! The terminal rows are dualized with a multiplier `ν` (at most 4 entries): the value
+//! function is `V_i(x) = ½ xᵀ P_i x + xᵀ (p_i + Γ_i ν) + ½ νᵀ W_i ν + w_iᵀ ν`, with
+//! `P_K = H_K`, `Γ_K = Eᵀ`, `W_K = 0`, `w_K = -e`, and per step (with
+//! `R̄ = R + BᵀPB`, `S̄ = Sᵀ + BᵀPA`, `K = -R̄⁻¹S̄`)
+//!
+//! ```text
+//! P_i = Q + AᵀPA + S̄ᵀK,            Γ_i = (A + BK)ᵀ Γ,     W_i = W - (BᵀΓ)ᵀ R̄⁻¹ (BᵀΓ),
+//! p_i = q + Aᵀ(Pf + p) + Kᵀ r̄,     w_i = w + Γᵀf + (BᵀΓ)ᵀ k,   r̄ = r + Bᵀ(Pf + p), k = -R̄⁻¹ r̄.
+//! ```
+//!
+//! `ν` maximizes the concave `V_0(x̂_0; ν)`: `-W_0 ν = Γ_0ᵀ x̂_0 + w_0`. The forward pass
+//! gives `u_i = K_i x_i + k_i - R̄⁻¹ BᵀΓ_{i+1} ν` and the multipliers of the dynamics
+//! rows `y_i = -(P_{i+1} x_{i+1} + p_{i+1} + Γ_{i+1} ν)` (rows written `x_{i+1} - A x - B u
+//! = c`), of the initial rows `-(P_0 x̂_0 + p_0 + Γ_0 ν)` and of the terminal rows `ν`.
+//!
+//! Every block has a fixed size (4 x 4, 4 x 2, 2 x 2); all buffers are sized by
+//! [`Riccati::resize`], so [`Riccati::factor`] and [`Riccati::solve`] never allocate.
+
+use nalgebra::{Matrix2, Matrix2x4, Matrix4, Matrix6, Vector2, Vector4, Vector6};
+
+use super::stage_qp::{Dynamics, NX};
+
+/// Static regularization added to every `R̄` (absolute, on top of a relative 1e-13):
+/// keeps the recursion defined when the acceleration has no cost of its own.
+const CONTROL_REGULARIZATION: f64 = 1e-10;
+
+/// Why a factorization failed.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum FactorError {
+    /// `R̄` of a step is not positive definite (non-convex or non-finite data).
+    ControlBlock(usize),
+    /// The terminal Schur complement `-W_0` is not positive definite even after
+    /// regularization (non-finite data).
+    Terminal,
+}
+
+/// The right-hand side of one Newton system.
+pub(crate) struct Rhs<'a> {
+    /// `g_i` (`K + 1`).
+    pub linear: &'a [Vector6<f64>],
+    /// `f_i` (`K`).
+    pub offsets: &'a [Vector4<f64>],
+    /// `x̂_0`.
+    pub initial: Vector4<f64>,
+    /// `e` (entries `0..m`).
+    pub terminal: Vector4<f64>,
+}
+
+/// The solution of one Newton system.
+pub(crate) struct Step<'a> {
+    /// `[x_i; u_i]` (`K + 1`, the last control zero).
+    pub z: &'a mut [Vector6<f64>],
+    /// Multipliers of the dynamics rows (`K`).
+    pub y_dynamics: &'a mut [Vector4<f64>],
+    /// Multipliers of the initial rows.
+    pub y_initial: &'a mut Vector4<f64>,
+    /// Multipliers of the terminal rows (entries `0..m`).
+    pub y_terminal: &'a mut Vector4<f64>,
+}
+
+/// Factorization and solve buffers for a horizon `K`.
+#[derive(Debug, Default)]
+pub(crate) struct Riccati {
+    k: usize,
+    m: usize,
+    p: Vec<Matrix4<f64>>,
+    gain: Vec<Matrix2x4<f64>>,
+    r_inv: Vec<Matrix2<f64>>,
+    gamma: Vec<Matrix4<f64>>,
+    bt_gamma: Vec<Matrix2x4<f64>>,
+    neg_w0_inv: Matrix4<f64>,
+    p_vec: Vec<Vector4<f64>>,
+    k_vec: Vec<Vector2<f64>>,
+}
+
+impl Riccati {
+    /// Sizes the buffers for horizon `k` (the only allocation).
+    pub fn resize(&mut self, k: usize) {
+        self.k = k;
+        self.p.resize(k + 1, Matrix4::zeros());
+        self.gain.resize(k, Matrix2x4::zeros());
+        self.r_inv.resize(k, Matrix2::zeros());
+        self.gamma.resize(k + 1, Matrix4::zeros());
+        self.bt_gamma.resize(k, Matrix2x4::zeros());
+        self.p_vec.resize(k + 1, Vector4::zeros());
+        self.k_vec.resize(k, Vector2::zeros());
+    }
+
+    /// Backward pass over the Hessian blocks `h` (`K + 1`), dynamics and the `m`
+    /// terminal rows `terminal` (rows `0..m` used).
+    pub fn factor(
+        &mut self,
+        h: &[Matrix6<f64>],
+        dynamics: &[Dynamics],
+        terminal: &Matrix4<f64>,
+        m: usize,
+    ) -> Result<(), FactorError> {
+        let k = self.k;
+        self.m = m;
+        self.p[k] = h[k].fixed_view::<4, 4>(0, 0).into_owned();
+        self.gamma[k] = terminal.transpose();
+        let mut w = Matrix4::<f64>::zeros();
+        for i in (0..k).rev() {
+            let Dynamics { a, b, .. } = &dynamics[i];
+            let hi = &h[i];
+            let p_next = &self.p[i + 1];
+            let pa = p_next * a;
+            let pb = p_next * b;
+            let mut r_bar = hi.fixed_view::<2, 2>(4, 4) + b.tr_mul(&pb);
+            let scale = r_bar[(0, 0)].abs().max(r_bar[(1, 1)].abs());
+            let reg = CONTROL_REGULARIZATION + 1e-13 * scale;
+            r_bar[(0, 0)] += reg;
+            r_bar[(1, 1)] += reg;
+            let r_inv = r_bar
+                .cholesky()
+                .map(|c| c.inverse())
+                .ok_or(FactorError::ControlBlock(i))?;
+            let s_bar = hi.fixed_view::<4, 2>(0, 4).transpose() + b.tr_mul(&pa);
+            let gain = -(r_inv * s_bar);
+            let mut p = hi.fixed_view::<4, 4>(0, 0) + a.tr_mul(&pa) + s_bar.tr_mul(&gain);
+            p = (p + p.transpose()) * 0.5;
+            let bt_gamma = b.tr_mul(&self.gamma[i + 1]);
+            self.gamma[i] = (a + b * gain).tr_mul(&self.gamma[i + 1]);
+            w -= bt_gamma.tr_mul(&(r_inv * bt_gamma));
+            self.p[i] = p;
+            self.gain[i] = gain;
+            self.r_inv[i] = r_inv;
+            self.bt_gamma[i] = bt_gamma;
+        }
+        // -W_0 on the m terminal rows; the unused rows get an identity.
+        let mut neg_w0 = -w;
+        let scale = (0..m).fold(0.0_f64, |s, j| s.max(neg_w0[(j, j)].abs()));
+        for j in 0..NX {
+            if j < m {
+                neg_w0[(j, j)] += 1e-14 * scale + f64::MIN_POSITIVE;
+            } else {
+                neg_w0[(j, j)] = 1.0;
+            }
+        }
+        let neg_w0 = (neg_w0 + neg_w0.transpose()) * 0.5;
+        self.neg_w0_inv = neg_w0
+            .cholesky()
+            .map(|c| c.inverse())
+            .ok_or(FactorError::Terminal)?;
+        Ok(())
+    }
+
+    /// Solves the Newton system of the last [`factor`](Self::factor) for `rhs`.
+    pub fn solve(&mut self, dynamics: &[Dynamics], rhs: &Rhs<'_>, out: Step<'_>) {
+        let k = self.k;
+        self.p_vec[k] = rhs.linear[k].fixed_rows::<4>(0).into_owned();
+        let mut w = -rhs.terminal;
+        for i in (0..k).rev() {
+            let Dynamics { a, b, .. } = &dynamics[i];
+            let f = &rhs.offsets[i];
+            let pf = self.p[i + 1] * f + self.p_vec[i + 1];
+            let r_bar = rhs.linear[i].fixed_rows::<2>(4) + b.tr_mul(&pf);
+            let kv = -(self.r_inv[i] * r_bar);
+            self.p_vec[i] =
+                rhs.linear[i].fixed_rows::<4>(0) + a.tr_mul(&pf) + self.gain[i].tr_mul(&r_bar);
+            w += self.gamma[i + 1].tr_mul(f) + self.bt_gamma[i].tr_mul(&kv);
+            self.k_vec[i] = kv;
+        }
+        let mut nu = self.neg_w0_inv * (self.gamma[0].tr_mul(&rhs.initial) + w);
+        for j in self.m..NX {
+            nu[j] = 0.0;
+        }
+        let mut x = rhs.initial;
+        *out.y_initial = -(self.p[0] * x + self.p_vec[0] + self.gamma[0] * nu);
+        for i in 0..k {
+            let Dynamics { a, b, .. } = &dynamics[i];
+            let u = self.gain[i] * x + self.k_vec[i] - self.r_inv[i] * (self.bt_gamma[i] * nu);
+            out.z[i].fixed_rows_mut::<4>(0).copy_from(&x);
+            out.z[i].fixed_rows_mut::<2>(4).copy_from(&u);
+            x = a * x + b * u + rhs.offsets[i];
+            out.y_dynamics[i] = -(self.p[i + 1] * x + self.p_vec[i + 1] + self.gamma[i + 1] * nu);
+        }
+        out.z[k] = Vector6::new(x[0], x[1], x[2], x[3], 0.0, 0.0);
+        *out.y_terminal = nu;
+    }
+}

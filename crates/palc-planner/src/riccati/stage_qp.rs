@@ -1,0 +1,227 @@
+//! The assembled QP read back in stage form: per step a 6 x 6 cost block over
+//! `[X_i; U_i]`, the affine dynamics `X_{i+1} = A_i X_i + B_i U_i + c_i`, the fixed
+//! `X_0`, the terminal rows `E X_K = e`, and inequality rows that each touch one
+//! stage variable and at most one soft-bound slack.
+//!
+//! The stage form is read from [`QpData`] (the one assembly of Eqs. 11-23), never
+//! built a second time from the [`Problem`](crate::Problem), so both backends solve
+//! the same numbers.
+
+use nalgebra::{Matrix4, Matrix4x2, Matrix6, Vector4, Vector6};
+
+use crate::qp::QpData;
+
+/// States per step.
+pub(crate) const NX: usize = 4;
+/// Variables per stage (state and control).
+pub(crate) const NZ: usize = 6;
+
+/// `X_{i+1} = a X_i + b U_i + c` (Eqs. 11-14).
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Dynamics {
+    pub a: Matrix4<f64>,
+    pub b: Matrix4x2<f64>,
+    pub c: Vector4<f64>,
+}
+
+/// One inequality row `coef · z[core] + slack_coef · σ[slack] <= h`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Inequality {
+    /// `(stage, local index in [X; U])` of the stage variable, if any.
+    pub core: Option<(usize, usize)>,
+    pub coef: f64,
+    /// Index of the slack variable, if any.
+    pub slack: Option<usize>,
+    pub slack_coef: f64,
+    pub h: f64,
+}
+
+/// The QP of [`QpData`] in stage form.
+#[derive(Debug, Default)]
+pub(crate) struct StageQp {
+    /// Horizon `K`.
+    pub k: usize,
+    /// Cost Hessian block of stage `i` over `[X_i; U_i]` (`K + 1` blocks; the last has
+    /// only its state corner).
+    pub hessian: Vec<Matrix6<f64>>,
+    /// Linear cost of stage `i` (`K + 1`).
+    pub linear: Vec<Vector6<f64>>,
+    /// Dynamics of steps `0..K`.
+    pub dynamics: Vec<Dynamics>,
+    /// The fixed initial state.
+    pub x0: Vector4<f64>,
+    /// Number of terminal rows `m <= 4`.
+    pub terminal_rows: usize,
+    /// `E` (rows `0..m`).
+    pub terminal: Matrix4<f64>,
+    /// `e` (entries `0..m`).
+    pub terminal_rhs: Vector4<f64>,
+    /// Linear cost of each slack.
+    pub slack_cost: Vec<f64>,
+    /// The stage variable each slack is tied to by its rows, if any.
+    pub slack_core: Vec<Option<(usize, usize)>>,
+    /// Inequality rows in the order of the QP's rows.
+    pub inequalities: Vec<Inequality>,
+    /// Equality rows `m_eq = 4 + 4K + m`.
+    pub m_eq: usize,
+}
+
+/// Where a QP variable lives.
+enum Var {
+    Core(usize, usize),
+    Slack(usize),
+}
+
+impl StageQp {
+    /// Reads `data` (assembled for horizon `k`) into stage form, reusing the buffers.
+    /// Fails with a description when the data does not have the planner's layout.
+    pub fn load(&mut self, data: &QpData, k: usize) -> Result<(), String> {
+        let n_core = NZ * k + NX;
+        if data.n < n_core || data.m_eq < NX + NX * k || data.m_eq > 2 * NX + NX * k {
+            return Err(format!(
+                "unexpected QP size n = {}, m_eq = {} for K = {k}",
+                data.n, data.m_eq
+            ));
+        }
+        let n_slack = data.n - n_core;
+        let var = |col: usize| {
+            if col < n_core {
+                Var::Core(col / NZ, col % NZ)
+            } else {
+                Var::Slack(col - n_core)
+            }
+        };
+        self.k = k;
+        self.hessian.clear();
+        self.hessian.resize(k + 1, Matrix6::zeros());
+        self.linear.clear();
+        self.linear.resize(k + 1, Vector6::zeros());
+        self.dynamics.clear();
+        self.dynamics.resize(k, Dynamics::default());
+        self.slack_cost.clear();
+        self.slack_cost.extend_from_slice(&data.q[n_core..]);
+        self.slack_core.clear();
+        self.slack_core.resize(n_slack, None);
+        self.inequalities.clear();
+        self.x0 = Vector4::zeros();
+        self.terminal = Matrix4::zeros();
+        self.terminal_rhs = Vector4::zeros();
+        self.m_eq = data.m_eq;
+        self.terminal_rows = data.m_eq - NX - NX * k;
+
+        for ((&r, &c), &v) in data.p_rows.iter().zip(&data.p_cols).zip(&data.p_vals) {
+            match (var(r), var(c)) {
+                (Var::Core(i, a), Var::Core(j, b)) if i == j => {
+                    self.hessian[i][(a, b)] += v;
+                    if a != b {
+                        self.hessian[i][(b, a)] += v;
+                    }
+                }
+                _ => return Err(format!("Hessian entry ({r}, {c}) couples two stages")),
+            }
+        }
+        for (col, &v) in data.q[..n_core].iter().enumerate() {
+            self.linear[col / NZ][col % NZ] = v;
+        }
+
+        let first_terminal = NX + NX * k;
+        for ((&r, &c), &v) in data.a_rows.iter().zip(&data.a_cols).zip(&data.a_vals) {
+            let Var::Core(stage, local) = var(c) else {
+                if r < data.m_eq {
+                    return Err(format!("equality row {r} involves a slack"));
+                }
+                continue;
+            };
+            if r < NX {
+                if (stage, local) != (0, r) || v != 1.0 {
+                    return Err(format!("initial row {r} is not X_0[{r}] = x0"));
+                }
+            } else if r < first_terminal {
+                let (step, comp) = ((r - NX) / NX, (r - NX) % NX);
+                if stage == step + 1 {
+                    if local != comp || v != 1.0 {
+                        return Err(format!("dynamics row {r} is not X_(i+1)[{comp}] = ..."));
+                    }
+                } else if stage == step && local < NX {
+                    self.dynamics[step].a[(comp, local)] -= v;
+                } else if stage == step {
+                    self.dynamics[step].b[(comp, local - NX)] -= v;
+                } else {
+                    return Err(format!("dynamics row {r} reaches stage {stage}"));
+                }
+            } else if r < data.m_eq {
+                if stage != k || local >= NX {
+                    return Err(format!("terminal row {r} involves stage {stage}"));
+                }
+                self.terminal[(r - first_terminal, local)] += v;
+            }
+        }
+        for r in 0..NX {
+            self.x0[r] = data.b[r];
+        }
+        for step in 0..k {
+            for comp in 0..NX {
+                self.dynamics[step].c[comp] = data.b[NX + NX * step + comp];
+            }
+        }
+        for j in 0..self.terminal_rows {
+            self.terminal_rhs[j] = data.b[first_terminal + j];
+        }
+
+        let m_in = data.b.len() - data.m_eq;
+        self.inequalities.resize(
+            m_in,
+            Inequality {
+                core: None,
+                coef: 0.0,
+                slack: None,
+                slack_coef: 0.0,
+                h: 0.0,
+            },
+        );
+        for (row, h) in data.b[data.m_eq..].iter().enumerate() {
+            self.inequalities[row].h = *h;
+        }
+        for ((&r, &c), &v) in data.a_rows.iter().zip(&data.a_cols).zip(&data.a_vals) {
+            if r < data.m_eq {
+                continue;
+            }
+            let row = &mut self.inequalities[r - data.m_eq];
+            match var(c) {
+                Var::Core(stage, local) if row.core.is_none() => {
+                    row.core = Some((stage, local));
+                    row.coef = v;
+                }
+                Var::Slack(j) if row.slack.is_none() => {
+                    row.slack = Some(j);
+                    row.slack_coef = v;
+                }
+                _ => {
+                    return Err(format!(
+                        "inequality row {r} has more than one variable of a kind"
+                    ));
+                }
+            }
+        }
+        let mut slack_rows = vec![0usize; n_slack];
+        for (row, ineq) in self.inequalities.iter().enumerate() {
+            let Some(j) = ineq.slack else { continue };
+            slack_rows[j] += 1;
+            if let Some(core) = ineq.core {
+                match self.slack_core[j] {
+                    None => self.slack_core[j] = Some(core),
+                    Some(other) if other == core => {}
+                    Some(_) => {
+                        return Err(format!(
+                            "slack {j} is tied to two stage variables (row {row})"
+                        ));
+                    }
+                }
+            }
+        }
+        if let Some(j) = slack_rows.iter().position(|&n| n == 0) {
+            return Err(format!("slack {j} has no inequality row"));
+        }
+        Ok(())
+    }
+}
