@@ -31,11 +31,12 @@ pub enum Backend {
     /// A Mehrotra predictor-corrector interior point whose Newton systems are solved by
     /// a time-varying Riccati recursion over the stages (fixed-size 4 x 4 and 2 x 2
     /// blocks, no allocation inside the iterations). It reads the tolerances and
-    /// `max_iter` of [`SolverSettings`]; the other settings are clarabel's.
+    /// `max_iter` of [`SolverSettings`]; the other settings are clarabel's. The default:
+    /// it agrees with clarabel in the property tests and is 4-5 times faster.
+    #[default]
     Riccati,
     /// The general sparse interior-point solver of the `clarabel` crate, kept as the
     /// reference.
-    #[default]
     Clarabel,
 }
 
@@ -115,7 +116,7 @@ impl Default for PlannerConfig {
             steering_min: -0.5,
             steering_max: 0.5,
             lateral_bounds_mode: LateralBoundsMode::Soft { weight: 100.0 },
-            backend: Backend::Clarabel,
+            backend: Backend::Riccati,
             solver: SolverSettings::default(),
         }
     }

@@ -11,7 +11,10 @@
 //!
 //! The start is Mehrotra's: the Newton system with `W = I` at `z = 0`, then `s` and `λ`
 //! shifted into the positive orthant. The stopping rule uses clarabel's measures on
-//! the unscaled data (relative primal and dual residuals, absolute or relative gap).
+//! the unscaled data (relative primal and dual residuals, absolute or relative gap),
+//! with the gap taken relative to the objective *with* its constant: the tracking term
+//! expands into `zᵀPz + qᵀz` parts of order 1e5 that cancel against the constant, and
+//! a gap relative to them stopped measurably short of the optimum.
 //! A primal infeasibility certificate `(y, λ)` with `Aᵀy + Gᵀλ = 0`, `bᵀy + hᵀλ < 0`
 //! is checked at every iterate; when the constraints are inconsistent the multipliers
 //! of an infeasible-start method grow along such a ray.
@@ -99,6 +102,7 @@ pub(crate) struct Ipm {
     r_in: Vec<f64>,
     // Newton system.
     w: Vec<f64>,
+    inv_s: Vec<f64>,
     xi: Vec<f64>,
     rc: Vec<f64>,
     newton_h: Vec<Matrix6<f64>>,
@@ -112,8 +116,6 @@ pub(crate) struct Ipm {
     d_sigma: Vec<f64>,
     ds: Vec<f64>,
     d_lambda: Vec<f64>,
-    ds_affine: Vec<f64>,
-    d_lambda_affine: Vec<f64>,
     y_initial_new: Vector4<f64>,
     y_dynamics_new: Vec<Vector4<f64>>,
     y_terminal_new: Vector4<f64>,
@@ -162,12 +164,11 @@ impl Ipm {
             &mut self.lambda,
             &mut self.r_in,
             &mut self.w,
+            &mut self.inv_s,
             &mut self.xi,
             &mut self.rc,
             &mut self.ds,
             &mut self.d_lambda,
-            &mut self.ds_affine,
-            &mut self.d_lambda_affine,
         ] {
             v.clear();
             v.resize(m_in, 0.0);
@@ -265,16 +266,13 @@ impl Ipm {
     /// One predictor-corrector iteration; returns the step length.
     fn iterate(&mut self, qp: &StageQp) -> Result<f64, FactorError> {
         let m_in = self.s.len() as f64;
-        let mu = self
-            .s
-            .iter()
-            .zip(&self.lambda)
-            .map(|(s, l)| s * l)
-            .sum::<f64>()
-            / m_in;
+        let mut sl = 0.0;
         for j in 0..self.s.len() {
-            self.w[j] = self.lambda[j] / self.s[j];
+            self.inv_s[j] = 1.0 / self.s[j];
+            self.w[j] = self.lambda[j] * self.inv_s[j];
+            sl += self.s[j] * self.lambda[j];
         }
+        let mu = sl / m_in;
         self.factor(qp)?;
 
         // Predictor: r_c = s∘λ, so ξ = λ + W r_in - r_c / s = W r_in.
@@ -283,29 +281,22 @@ impl Ipm {
             self.xi[j] = self.w[j] * self.r_in[j];
         }
         self.newton_step(qp);
-        self.dual_step();
-        let alpha = self.step_to_boundary();
-        let mu_affine = self
-            .s
-            .iter()
-            .zip(&self.ds)
-            .zip(self.lambda.iter().zip(&self.d_lambda))
-            .map(|((s, ds), (l, dl))| (s + alpha * ds) * (l + alpha * dl))
-            .sum::<f64>()
-            / m_in;
-        let centering = (mu_affine / mu).clamp(0.0, 1.0).powi(3);
-        self.ds_affine.copy_from_slice(&self.ds);
-        self.d_lambda_affine.copy_from_slice(&self.d_lambda);
-
-        // Corrector with centring.
+        let alpha = self.dual_step_to_boundary();
+        let mut mu_affine = 0.0;
         for j in 0..self.s.len() {
-            self.rc[j] = self.s[j] * self.lambda[j] + self.ds_affine[j] * self.d_lambda_affine[j]
-                - centering * mu;
-            self.xi[j] = self.lambda[j] + self.w[j] * self.r_in[j] - self.rc[j] / self.s[j];
+            let (ds, dl) = (self.ds[j], self.d_lambda[j]);
+            mu_affine += (self.s[j] + alpha * ds) * (self.lambda[j] + alpha * dl);
+            // Corrector with centring, from the affine step.
+            self.rc[j] = self.s[j] * self.lambda[j] + ds * dl;
+        }
+        let centering = (mu_affine / m_in / mu).clamp(0.0, 1.0).powi(3);
+        let shift = centering * mu;
+        for j in 0..self.s.len() {
+            self.rc[j] -= shift;
+            self.xi[j] = self.lambda[j] + self.w[j] * self.r_in[j] - self.rc[j] * self.inv_s[j];
         }
         self.newton_step(qp);
-        self.dual_step();
-        let alpha = (STEP_FRACTION * self.step_to_boundary()).min(1.0);
+        let alpha = (STEP_FRACTION * self.dual_step_to_boundary()).min(1.0);
 
         for i in 0..self.z.len() {
             self.z[i] += alpha * self.dz[i];
@@ -326,22 +317,19 @@ impl Ipm {
         Ok(alpha)
     }
 
-    /// `Δλ = -r_c / s - W Δs`.
-    fn dual_step(&mut self) {
-        for j in 0..self.s.len() {
-            self.d_lambda[j] = -self.rc[j] / self.s[j] - self.w[j] * self.ds[j];
-        }
-    }
-
-    /// The largest `α <= 1` with `s + α Δs >= 0` and `λ + α Δλ >= 0`.
-    fn step_to_boundary(&self) -> f64 {
+    /// `Δλ = -r_c / s - W Δs`, and the largest `α <= 1` with `s + α Δs >= 0` and
+    /// `λ + α Δλ >= 0`.
+    fn dual_step_to_boundary(&mut self) -> f64 {
         let mut alpha = 1.0_f64;
         for j in 0..self.s.len() {
-            if self.ds[j] < 0.0 {
-                alpha = alpha.min(-self.s[j] / self.ds[j]);
+            let ds = self.ds[j];
+            let dl = -(self.rc[j] + self.lambda[j] * ds) * self.inv_s[j];
+            self.d_lambda[j] = dl;
+            if ds < 0.0 {
+                alpha = alpha.min(-self.s[j] / ds);
             }
-            if self.d_lambda[j] < 0.0 {
-                alpha = alpha.min(-self.lambda[j] / self.d_lambda[j]);
+            if dl < 0.0 {
+                alpha = alpha.min(-self.lambda[j] / dl);
             }
         }
         alpha
@@ -525,8 +513,10 @@ impl Ipm {
             .iter()
             .fold(0.0_f64, |n, v| n.max(v.amax()))
             .max(norm_inf(&self.r_dual_sigma));
-        let pobj = 0.5 * xpx + qx;
-        let dobj = -0.5 * xpx - by - hl;
+        // With the constant, so that the relative gap is relative to the plan's
+        // objective and not to terms that cancel against the constant.
+        let pobj = 0.5 * xpx + qx + qp.constant;
+        let dobj = -0.5 * xpx - by - hl + qp.constant;
         let gap_abs = (pobj - dobj).abs();
         Measures {
             res_primal: primal / (self.norm_b + norm_z + norm_s).max(1.0),

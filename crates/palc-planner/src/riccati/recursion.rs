@@ -119,9 +119,13 @@ impl Riccati {
             let reg = CONTROL_REGULARIZATION + 1e-13 * scale;
             r_bar[(0, 0)] += reg;
             r_bar[(1, 1)] += reg;
-            let r_inv = r_bar
-                .cholesky()
-                .map(|c| c.inverse())
+            // Positive definite iff the leading entry and the determinant are positive;
+            // then nalgebra's closed-form 2 x 2 inverse.
+            let positive = r_bar[(0, 0)] > 0.0 && r_bar.determinant() > 0.0;
+            let r_inv = positive
+                .then(|| r_bar.try_inverse())
+                .flatten()
+                .filter(|m| m.iter().all(|x| x.is_finite()))
                 .ok_or(FactorError::ControlBlock(i))?;
             let s_bar = hi.fixed_view::<4, 2>(0, 4).transpose() + b.tr_mul(&pa);
             let gain = -(r_inv * s_bar);

@@ -64,6 +64,8 @@ pub(crate) struct StageQp {
     pub inequalities: Vec<Inequality>,
     /// Equality rows `m_eq = 4 + 4K + m`.
     pub m_eq: usize,
+    /// The constant of the objective (squared-distance and tracking constants).
+    pub constant: f64,
 }
 
 /// Where a QP variable lives.
@@ -107,6 +109,7 @@ impl StageQp {
         self.terminal = Matrix4::zeros();
         self.terminal_rhs = Vector4::zeros();
         self.m_eq = data.m_eq;
+        self.constant = data.constant;
         self.terminal_rows = data.m_eq - NX - NX * k;
 
         for ((&r, &c), &v) in data.p_rows.iter().zip(&data.p_cols).zip(&data.p_vals) {

@@ -1,0 +1,211 @@
+//! The Riccati interior point and clarabel solve the same QP: on random convex
+//! problems, with and without active bounds, their objectives agree to 1e-6 relative
+//! and, the optimum being unique (`ρ_a > 0`, `w8 > 0`), every state and control agrees
+//! to 1e-3 (m, m/s, rad, m/s²): both stop at a relative gap of 1e-8, and in the flattest
+//! directions (soft bounds at their kink) that leaves differences of up to 1.2e-4 rad
+//! in δ for 3e-7 of objective (measured over 1200 random problems); on
+//! infeasible problems both refuse with `Infeasible`, and both report the same typed
+//! errors for invalid input and for too few iterations.
+
+mod common;
+
+use common::{convex_problem, lane_change};
+use palc_planner::{
+    Backend, LateralBound, LateralBoundsMode, Plan, PlanError, Planner, PlannerConfig, Problem,
+    SolverSettings,
+};
+use proptest::prelude::*;
+
+fn plan_with(
+    backend: Backend,
+    config: &PlannerConfig,
+    problem: &Problem,
+) -> Result<Plan, PlanError> {
+    Planner::new(PlannerConfig {
+        backend,
+        ..config.clone()
+    })?
+    .plan(problem)
+}
+
+/// Largest difference of the two plans' states and controls, per quantity:
+/// `[s, v, l, φ, a, δ]`.
+fn max_differences(a: &Plan, b: &Plan) -> [f64; 6] {
+    let mut d = [0.0_f64; 6];
+    for (x, y) in a.states.iter().zip(&b.states) {
+        for (c, (p, q)) in x.to_array().iter().zip(y.to_array()).enumerate() {
+            d[c] = d[c].max((p - q).abs());
+        }
+    }
+    for (u, w) in a.controls.iter().zip(&b.controls) {
+        d[4] = d[4].max((u.a - w.a).abs());
+        d[5] = d[5].max((u.delta - w.delta).abs());
+    }
+    d
+}
+
+/// clarabel as an accurate reference: iterative refinement on and tolerances of 1e-10
+/// (with its speed settings, a hard-bounded case stopped 6.5e-5 above the optimum).
+fn reference_config(config: &PlannerConfig) -> PlannerConfig {
+    PlannerConfig {
+        solver: SolverSettings {
+            iterative_refinement_enable: true,
+            tol_gap_abs: 1e-10,
+            tol_gap_rel: 1e-10,
+            tol_feas: 1e-10,
+            ..SolverSettings::default()
+        },
+        ..config.clone()
+    }
+}
+
+/// The trajectory tolerance of the module docs, `[s, v, l, φ, a, δ]`.
+const TRAJECTORY_TOLERANCE: [f64; 6] = [1e-3; 6];
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        rng_seed: proptest::test_runner::RngSeed::Fixed(20261123),
+        failure_persistence: None,
+        ..ProptestConfig::with_cases(64)
+    })]
+
+    #[test]
+    fn both_backends_find_the_same_optimum((config, problem) in convex_problem()) {
+        let riccati = plan_with(Backend::Riccati, &config, &problem).unwrap();
+        let clarabel = plan_with(Backend::Clarabel, &reference_config(&config), &problem).unwrap();
+        let scale = 1.0 + clarabel.objective.abs();
+        prop_assert!(
+            (riccati.objective - clarabel.objective).abs() <= 1e-6 * scale,
+            "objective riccati {} vs clarabel {}", riccati.objective, clarabel.objective
+        );
+        let d = max_differences(&riccati, &clarabel);
+        for (c, (&found, &bound)) in d.iter().zip(&TRAJECTORY_TOLERANCE).enumerate() {
+            prop_assert!(found <= bound, "component {} differs by {:e} (bound {:e}); objectives riccati {} clarabel {} (diff {:e}), iterations {} / {}, mode {:?}", c, found, bound, riccati.objective, clarabel.objective, riccati.objective - clarabel.objective, riccati.stats.iterations, clarabel.stats.iterations, config.lateral_bounds_mode);
+        }
+        for (x, y) in riccati.lateral_violation.iter().zip(&clarabel.lateral_violation) {
+            prop_assert!((x - y).abs() <= 1e-4, "slack {} vs {}", x, y);
+        }
+    }
+
+    #[test]
+    fn both_backends_refuse_an_unreachable_zone(
+        k in 30usize..60,
+        start in 1usize..4,
+        min in 0.3..1.5f64,
+        soft_elsewhere in prop::bool::ANY,
+    ) {
+        // The steering bound keeps l below `reachable` at step `start + 2`.
+        let config = PlannerConfig {
+            horizon: k,
+            dt: 0.1,
+            steering_min: -0.01,
+            steering_max: 0.01,
+            lateral_bounds_mode: LateralBoundsMode::Hard,
+            ..PlannerConfig::default()
+        };
+        let mut problem = lane_change(&config, 20.0);
+        if soft_elsewhere {
+            problem.lateral_bounds[k / 2] = None;
+        }
+        for s in start..start + 3 {
+            problem.lateral_bounds[s] = Some(LateralBound::new(min, 3.0));
+        }
+        let reachable = 20.0 * 0.1 * (20.0 * 0.1 / 2.8 * 0.01) * (start as f64) * (start as f64);
+        prop_assume!(min > reachable + 0.05);
+        for backend in [Backend::Riccati, Backend::Clarabel] {
+            let err = plan_with(backend, &config, &problem).unwrap_err();
+            prop_assert!(matches!(err, PlanError::Infeasible { .. }), "{:?}: {:?}", backend, err);
+        }
+    }
+
+    #[test]
+    fn both_backends_refuse_an_unreachable_terminal_state(
+        k in 5usize..25,
+        steering in 0.001..0.01f64,
+        soft in prop::bool::ANY,
+    ) {
+        // With |δ| <= steering, l_K <= Σ_i dt v φ_i <= dt v (dt v / l_fr) steering K² / 2.
+        let config = PlannerConfig {
+            horizon: k,
+            dt: 0.1,
+            steering_min: -steering,
+            steering_max: steering,
+            lateral_bounds_mode: if soft {
+                LateralBoundsMode::Soft { weight: 100.0 }
+            } else {
+                LateralBoundsMode::Hard
+            },
+            ..PlannerConfig::default()
+        };
+        let problem = lane_change(&config, 20.0);
+        let reachable = 2.0 * (2.0 / 2.8) * steering * (k * k) as f64 / 2.0;
+        prop_assume!(problem.terminal.l > 1.5 * reachable);
+        for backend in [Backend::Riccati, Backend::Clarabel] {
+            let err = plan_with(backend, &config, &problem).unwrap_err();
+            prop_assert!(matches!(err, PlanError::Infeasible { .. }), "{:?}: {:?}", backend, err);
+        }
+    }
+}
+
+#[test]
+fn both_backends_locate_an_unreachable_bound() {
+    let config = PlannerConfig {
+        horizon: 40,
+        lateral_bounds_mode: LateralBoundsMode::Hard,
+        ..PlannerConfig::default()
+    };
+    let mut problem = lane_change(&config, 20.0);
+    // l_1 = l_0 + dt v φ_0 = 0 is fixed by X_0, so l_1 >= 0.5 cannot hold.
+    problem.lateral_bounds[1] = Some(LateralBound::new(0.5, 1.0));
+    for backend in [Backend::Riccati, Backend::Clarabel] {
+        match plan_with(backend, &config, &problem).unwrap_err() {
+            PlanError::Infeasible { lateral_steps, .. } => {
+                assert!(lateral_steps.contains(1), "{backend:?}: {lateral_steps}");
+            }
+            other => panic!("{backend:?}: unexpected {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn both_backends_report_too_few_iterations_as_not_converged() {
+    let config = PlannerConfig {
+        horizon: 40,
+        solver: SolverSettings {
+            max_iter: 2,
+            ..SolverSettings::default()
+        },
+        ..PlannerConfig::default()
+    };
+    let problem = lane_change(&config, 20.0);
+    for backend in [Backend::Riccati, Backend::Clarabel] {
+        match plan_with(backend, &config, &problem).unwrap_err() {
+            PlanError::SolverFailed { status, iterations } => {
+                assert!(status.contains("MaxIter"), "{backend:?}: {status}");
+                assert_eq!(iterations, 2, "{backend:?}");
+            }
+            other => panic!("{backend:?}: unexpected {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn both_backends_refuse_invalid_input_alike() {
+    let config = PlannerConfig {
+        horizon: 30,
+        lateral_bounds_mode: LateralBoundsMode::Hard,
+        ..PlannerConfig::default()
+    };
+    let mut nan = lane_change(&config, 20.0);
+    nan.adjacent[3].l = f64::NAN;
+    let mut narrow = lane_change(&config, 20.0);
+    narrow.lateral_bounds[7] = Some(LateralBound::new(2.0, 1.0));
+    let mut non_convex = lane_change(&config, 20.0);
+    non_convex.weights.columns_mut()[4][7] = -1.0;
+    for problem in [nan, narrow, non_convex] {
+        let a = plan_with(Backend::Riccati, &config, &problem).unwrap_err();
+        let b = plan_with(Backend::Clarabel, &config, &problem).unwrap_err();
+        // NaN != NaN: compare the messages.
+        assert_eq!(a.to_string(), b.to_string());
+    }
+}
