@@ -1,13 +1,19 @@
 //! Per-plan time (validate, assemble, update or build, solve, extract) of the
-//! lane-change QP for K in {40, 60, 80, 120} and dt in {0.1, 0.05}.
+//! lane-change QP for both backends, K in {40, 60, 80, 120}, dt in {0.1, 0.05}, hard
+//! and soft lateral bounds.
 //!
 //! `reused`: one planner, problems whose values change between calls (the loop's case).
-//! `fresh`: a new planner per plan (symbolic analysis and equilibration every time).
+//! `fresh`: a new planner per plan (clarabel: symbolic analysis and equilibration every
+//! time; riccati: buffers allocated every time).
+//!
+//! Percentiles (p50, p99) and the speed-up in one run:
+//! `cargo run --release -p palc-planner --example plan_latency`.
 
 use std::hint::black_box;
+use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use palc_planner::{Planner, PlannerConfig, Problem};
+use palc_planner::{Backend, LateralBoundsMode, Planner, PlannerConfig, Problem};
 
 #[path = "../fixtures/lane_change.rs"]
 mod lane_change_fixture;
@@ -15,33 +21,50 @@ use lane_change_fixture::lane_change as problem;
 
 fn bench_plan(c: &mut Criterion) {
     let mut group = c.benchmark_group("plan");
-    for dt in [0.1, 0.05] {
-        for k in [40, 60, 80, 120] {
-            let config = PlannerConfig {
-                horizon: k,
-                dt,
-                ..PlannerConfig::default()
-            };
-            let problems: Vec<Problem> = [18.0, 20.0, 22.0, 26.0]
-                .iter()
-                .map(|&v| problem(&config, v))
-                .collect();
-            let id = format!("K={k},dt={dt}");
-            let mut planner = Planner::new(config.clone()).unwrap();
-            let mut n = 0;
-            group.bench_function(BenchmarkId::new("reused", &id), |b| {
-                b.iter(|| {
-                    n += 1;
-                    black_box(planner.plan(&problems[n % problems.len()]).unwrap())
-                })
-            });
-            group.bench_function(BenchmarkId::new("fresh", &id), |b| {
-                b.iter(|| {
-                    n += 1;
+    group
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(3));
+    for (mode_name, mode) in [
+        ("hard", LateralBoundsMode::Hard),
+        ("soft", LateralBoundsMode::Soft { weight: 100.0 }),
+    ] {
+        for dt in [0.1, 0.05] {
+            for k in [40, 60, 80, 120] {
+                for (backend_name, backend) in [
+                    ("riccati", Backend::Riccati),
+                    ("clarabel", Backend::Clarabel),
+                ] {
+                    let config = PlannerConfig {
+                        horizon: k,
+                        dt,
+                        backend,
+                        lateral_bounds_mode: mode,
+                        ..PlannerConfig::default()
+                    };
+                    let problems: Vec<Problem> = [18.0, 20.0, 22.0, 26.0]
+                        .iter()
+                        .map(|&v| problem(&config, v))
+                        .collect();
+                    let id = format!("{backend_name},{mode_name},K={k},dt={dt}");
                     let mut planner = Planner::new(config.clone()).unwrap();
-                    black_box(planner.plan(&problems[n % problems.len()]).unwrap())
-                })
-            });
+                    let mut n = 0;
+                    group.bench_function(BenchmarkId::new("reused", &id), |b| {
+                        b.iter(|| {
+                            n += 1;
+                            black_box(planner.plan(&problems[n % problems.len()]).unwrap())
+                        })
+                    });
+                    if k == 120 {
+                        group.bench_function(BenchmarkId::new("fresh", &id), |b| {
+                            b.iter(|| {
+                                n += 1;
+                                let mut planner = Planner::new(config.clone()).unwrap();
+                                black_box(planner.plan(&problems[n % problems.len()]).unwrap())
+                            })
+                        });
+                    }
+                }
+            }
         }
     }
     group.finish();

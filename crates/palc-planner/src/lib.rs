@@ -10,6 +10,12 @@
 //! acceleration penalty, an optional tracking term (the form of Eq. 25) and the
 //! slack penalty of soft lateral bounds.
 //!
+//! Two backends solve the same assembled QP ([`Backend`]): the default, a Mehrotra
+//! predictor-corrector interior point whose Newton systems are solved by a
+//! time-varying Riccati recursion over the stages (the structure the paper exploits
+//! with Pontryagin's principle), and the general sparse solver `clarabel`, kept as the
+//! reference. Property tests hold them to the same optimum.
+//!
 //! Main types: [`PlannerConfig`] (fixed between plans), [`Problem`] (one plan's input),
 //! [`Planner`] (caches the QP structure), [`Plan`] (trajectory, objective, features,
 //! statistics), [`Weights`] and [`Features`] (10 x K), [`features`] (the one feature map)

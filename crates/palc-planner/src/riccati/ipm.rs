@@ -24,12 +24,24 @@ use nalgebra::{Matrix6, Vector4, Vector6};
 use super::recursion::{FactorError, Rhs, Riccati, Step};
 use super::stage_qp::{NX, StageQp};
 
-/// Relative tolerance of the infeasibility certificate: `‖Aᵀy + Gᵀλ‖∞ <= TOL · -(bᵀy + hᵀλ)`.
-/// A feasible problem can pass it only if its solutions have `‖z‖₁ >= 1 / TOL`.
-const INFEASIBILITY_TOLERANCE: f64 = 1e-9;
-/// clarabel's reduced tolerances, used for `AlmostSolved`.
+/// Relative tolerance of the infeasibility certificate: `‖Aᵀy + Gᵀλ‖∞ <= TOL · -(bᵀy + hᵀλ)`
+/// (clarabel's `tol_infeas_rel`). A feasible problem can pass it only if its solutions
+/// have `‖z‖₁ >= 1 / TOL`. The multipliers grow to 1e13 before rounding in `Aᵀy + Gᵀλ`
+/// stops the ratio near 1e-9, so a tighter tolerance is not reachable.
+const INFEASIBILITY_TOLERANCE: f64 = 1e-8;
+/// clarabel's reduced tolerances, used when the iterations stop (`AlmostSolved`, or an
+/// infeasibility certificate at the reduced tolerance).
 const REDUCED_GAP: f64 = 5e-5;
 const REDUCED_FEAS: f64 = 1e-4;
+const REDUCED_INFEASIBILITY: f64 = 5e-5;
+/// Measures (relative dual residual and gap) below which the corrector step gets one
+/// step of iterative refinement.
+const REFINE_BELOW: f64 = 1e-5;
+/// Iterations without a better iterate, once one meets the reduced tolerances, after
+/// which the best is returned (`AlmostSolved`): a healthy interior point improves at
+/// every step near the optimum, and continuing only lets `W = λ / s` grow until the
+/// Newton steps lose all accuracy.
+const STAGNATION: u32 = 5;
 /// Fraction of the step to the boundary of the positive orthant.
 const STEP_FRACTION: f64 = 0.99;
 
@@ -64,20 +76,40 @@ struct Measures {
 }
 
 impl Measures {
+    /// How far from the stopping rule: at most 1 when it is met.
+    fn merit(&self, tol: &Tolerances) -> f64 {
+        let gap = (self.gap_abs / tol.gap_abs).min(self.gap_rel / tol.gap_rel);
+        (self.res_primal / tol.feas)
+            .max(self.res_dual / tol.feas)
+            .max(gap)
+    }
+
     fn meets(&self, gap_abs: f64, gap_rel: f64, feas: f64) -> bool {
         (self.gap_abs < gap_abs || self.gap_rel < gap_rel)
             && self.res_primal < feas
             && self.res_dual < feas
     }
 
-    fn infeasible(&self) -> bool {
+    fn infeasible(&self, tolerance: f64) -> bool {
         self.certificate_value < 0.0
-            && self.certificate_residual <= INFEASIBILITY_TOLERANCE * -self.certificate_value
+            && self.certificate_residual <= tolerance * -self.certificate_value
     }
 }
 
 fn norm_inf<'a>(values: impl IntoIterator<Item = &'a f64>) -> f64 {
     values.into_iter().fold(0.0_f64, |m, v| m.max(v.abs()))
+}
+
+/// A copy of the primal-dual iterate.
+#[derive(Debug, Default)]
+struct Iterate {
+    z: Vec<Vector6<f64>>,
+    sigma: Vec<f64>,
+    y_initial: Vector4<f64>,
+    y_dynamics: Vec<Vector4<f64>>,
+    y_terminal: Vector4<f64>,
+    s: Vec<f64>,
+    lambda: Vec<f64>,
 }
 
 /// The iterate, the residuals and every buffer of the Newton systems.
@@ -119,7 +151,17 @@ pub(crate) struct Ipm {
     y_initial_new: Vector4<f64>,
     y_dynamics_new: Vec<Vector4<f64>>,
     y_terminal_new: Vector4<f64>,
+    // Iterative refinement: the residual of the stationarity rows and the correction.
+    e: Vec<Vector6<f64>>,
+    e_sigma: Vec<f64>,
+    zero_offsets: Vec<Vector4<f64>>,
+    dz_c: Vec<Vector6<f64>>,
+    y_dynamics_c: Vec<Vector4<f64>>,
     riccati: Riccati,
+    // The best iterate so far, returned when the iterations stagnate near the optimum.
+    best_iterate: Iterate,
+    best: Option<Measures>,
+    best_merit: f64,
     // Data norms.
     norm_b: f64,
     norm_q: f64,
@@ -135,6 +177,8 @@ impl Ipm {
             &mut self.r_dual,
             &mut self.g,
             &mut self.dz,
+            &mut self.e,
+            &mut self.dz_c,
         ] {
             v.clear();
             v.resize(k + 1, Vector6::zeros());
@@ -144,6 +188,8 @@ impl Ipm {
             &mut self.r_dynamics,
             &mut self.offsets,
             &mut self.y_dynamics_new,
+            &mut self.zero_offsets,
+            &mut self.y_dynamics_c,
         ] {
             v.clear();
             v.resize(k, Vector4::zeros());
@@ -155,6 +201,7 @@ impl Ipm {
             &mut self.h_sv,
             &mut self.g_sigma,
             &mut self.d_sigma,
+            &mut self.e_sigma,
         ] {
             v.clear();
             v.resize(n_slack, 0.0);
@@ -175,6 +222,20 @@ impl Ipm {
         }
         self.newton_h.clear();
         self.newton_h.resize(k + 1, Matrix6::zeros());
+        let b = &mut self.best_iterate;
+        b.z.clear();
+        b.z.resize(k + 1, Vector6::zeros());
+        b.y_dynamics.clear();
+        b.y_dynamics.resize(k, Vector4::zeros());
+        for v in [&mut b.sigma] {
+            v.clear();
+            v.resize(n_slack, 0.0);
+        }
+        for v in [&mut b.s, &mut b.lambda] {
+            v.clear();
+            v.resize(m_in, 0.0);
+        }
+        self.best = None;
         self.riccati.resize(k);
         self.y_initial = Vector4::zeros();
         self.y_terminal = Vector4::zeros();
@@ -194,34 +255,89 @@ impl Ipm {
     /// Runs the interior point from Mehrotra's start; the iterate holds the result.
     pub fn run(&mut self, qp: &StageQp, tol: &Tolerances) -> Outcome {
         if let Err(e) = self.start(qp) {
-            return failed(e);
+            return Outcome::Failed(describe(e));
         }
         let mut stalled = 0;
+        let mut since_best = 0;
+        self.best_merit = f64::INFINITY;
         loop {
             let measures = self.residuals(qp);
             if measures.meets(tol.gap_abs, tol.gap_rel, tol.feas) {
                 return Outcome::Solved;
             }
-            if measures.infeasible() {
+            if measures.infeasible(INFEASIBILITY_TOLERANCE) {
                 return Outcome::PrimalInfeasible;
             }
-            if self.iterations >= tol.max_iter || stalled >= 3 {
-                if measures.meets(REDUCED_GAP, REDUCED_GAP, REDUCED_FEAS) {
-                    return Outcome::AlmostSolved;
-                }
-                return Outcome::Failed(if stalled >= 3 {
-                    "InsufficientProgress".into()
+            let merit = measures.merit(tol);
+            if merit < self.best_merit {
+                self.save_best(merit, measures);
+                since_best = 0;
+            } else {
+                since_best += 1;
+            }
+            let stagnant = since_best >= STAGNATION
+                && self
+                    .best
+                    .is_some_and(|b| b.meets(REDUCED_GAP, REDUCED_GAP, REDUCED_FEAS));
+            if self.iterations >= tol.max_iter || stalled >= 3 || stagnant {
+                let reason = if stalled >= 3 || stagnant {
+                    "InsufficientProgress"
                 } else {
-                    "MaxIterations".into()
-                });
+                    "MaxIterations"
+                };
+                return self.stop(&measures, reason.into());
             }
             self.iterations += 1;
-            match self.iterate(qp) {
+            // Near the optimum, `W = λ / s` spans many orders of magnitude and the
+            // Newton step loses accuracy in the stationarity rows: refine it then.
+            let refine = measures.res_dual.max(measures.gap_rel) < REFINE_BELOW;
+            match self.iterate(qp, refine) {
                 Ok(alpha) if alpha < 1e-8 => stalled += 1,
                 Ok(_) => stalled = 0,
-                Err(e) => return failed(e),
+                Err(e) => return self.stop(&measures, describe(e)),
             }
         }
+    }
+
+    /// The end without convergence: the best iterate if it meets clarabel's reduced
+    /// tolerances (`AlmostSolved`), an infeasibility certificate at the reduced
+    /// tolerance, or the failure `reason`.
+    fn stop(&mut self, current: &Measures, reason: String) -> Outcome {
+        if self
+            .best
+            .is_some_and(|b| b.meets(REDUCED_GAP, REDUCED_GAP, REDUCED_FEAS))
+        {
+            self.restore_best();
+            return Outcome::AlmostSolved;
+        }
+        if current.infeasible(REDUCED_INFEASIBILITY) {
+            return Outcome::PrimalInfeasible;
+        }
+        Outcome::Failed(reason)
+    }
+
+    fn save_best(&mut self, merit: f64, measures: Measures) {
+        self.best_merit = merit;
+        self.best = Some(measures);
+        let b = &mut self.best_iterate;
+        b.z.copy_from_slice(&self.z);
+        b.sigma.copy_from_slice(&self.sigma);
+        b.y_dynamics.copy_from_slice(&self.y_dynamics);
+        b.s.copy_from_slice(&self.s);
+        b.lambda.copy_from_slice(&self.lambda);
+        b.y_initial = self.y_initial;
+        b.y_terminal = self.y_terminal;
+    }
+
+    fn restore_best(&mut self) {
+        let b = &self.best_iterate;
+        self.z.copy_from_slice(&b.z);
+        self.sigma.copy_from_slice(&b.sigma);
+        self.y_dynamics.copy_from_slice(&b.y_dynamics);
+        self.s.copy_from_slice(&b.s);
+        self.lambda.copy_from_slice(&b.lambda);
+        self.y_initial = b.y_initial;
+        self.y_terminal = b.y_terminal;
     }
 
     /// Mehrotra's starting point.
@@ -264,7 +380,7 @@ impl Ipm {
     }
 
     /// One predictor-corrector iteration; returns the step length.
-    fn iterate(&mut self, qp: &StageQp) -> Result<f64, FactorError> {
+    fn iterate(&mut self, qp: &StageQp, refine: bool) -> Result<f64, FactorError> {
         let m_in = self.s.len() as f64;
         let mut sl = 0.0;
         for j in 0..self.s.len() {
@@ -296,6 +412,10 @@ impl Ipm {
             self.xi[j] = self.lambda[j] + self.w[j] * self.r_in[j] - self.rc[j] * self.inv_s[j];
         }
         self.newton_step(qp);
+        if refine {
+            self.dual_step_to_boundary();
+            self.refine(qp);
+        }
         let alpha = (STEP_FRACTION * self.dual_step_to_boundary()).min(1.0);
 
         for i in 0..self.z.len() {
@@ -335,25 +455,113 @@ impl Ipm {
         alpha
     }
 
-    /// `P + Gᵀ W G` in stage form, the slacks eliminated, and its Riccati factorization.
-    fn factor(&mut self, qp: &StageQp) -> Result<(), FactorError> {
-        self.newton_h.copy_from_slice(&qp.hessian);
-        self.h_ss.fill(0.0);
-        self.h_sv.fill(0.0);
-        for (row, &w) in qp.inequalities.iter().zip(&self.w) {
+    /// One step of iterative refinement of the Newton step: the residual
+    /// `e = P Δz + Aᵀ Δy + Gᵀ Δλ + r_d` of the stationarity rows (the other rows hold
+    /// by construction), then the correction from the same factorization with `-e` on
+    /// the right-hand side and zero equality residuals.
+    fn refine(&mut self, qp: &StageQp) {
+        let k = qp.k;
+        for i in 0..=k {
+            self.e[i] = qp.hessian[i] * self.dz[i] + self.r_dual[i];
+        }
+        self.e_sigma.copy_from_slice(&self.r_dual_sigma);
+        head(&mut self.e[0], &(self.y_initial_new - self.y_initial));
+        for i in 0..k {
+            let d = &qp.dynamics[i];
+            let dy = self.y_dynamics_new[i] - self.y_dynamics[i];
+            head(&mut self.e[i + 1], &dy);
+            head(&mut self.e[i], &-d.a.tr_mul(&dy));
+            let mut tail = self.e[i].fixed_rows_mut::<2>(4);
+            tail -= d.b.tr_mul(&dy);
+        }
+        let dnu = self.y_terminal_new - self.y_terminal;
+        head(&mut self.e[k], &qp.terminal.tr_mul(&dnu));
+        for (row, &dl) in qp.inequalities.iter().zip(&self.d_lambda) {
             if let Some((i, l)) = row.core {
-                self.newton_h[i][(l, l)] += w * row.coef * row.coef;
+                self.e[i][l] += row.coef * dl;
             }
             if let Some(j) = row.slack {
-                self.h_ss[j] += w * row.slack_coef * row.slack_coef;
-                if row.core.is_some() {
-                    self.h_sv[j] += w * row.coef * row.slack_coef;
-                }
+                self.e_sigma[j] += row.slack_coef * dl;
             }
         }
         for (j, core) in qp.slack_core.iter().enumerate() {
             if let Some((i, l)) = *core {
-                self.newton_h[i][(l, l)] -= self.h_sv[j] * self.h_sv[j] / self.h_ss[j];
+                self.e[i][l] -= self.h_sv[j] * self.e_sigma[j] / self.h_ss[j];
+            }
+        }
+        let rhs = Rhs {
+            linear: &self.e,
+            offsets: &self.zero_offsets,
+            initial: Vector4::zeros(),
+            terminal: Vector4::zeros(),
+        };
+        let (mut dy0, mut dnu) = (Vector4::zeros(), Vector4::zeros());
+        self.riccati.solve(
+            &qp.dynamics,
+            &rhs,
+            Step {
+                z: &mut self.dz_c,
+                y_dynamics: &mut self.y_dynamics_c,
+                y_initial: &mut dy0,
+                y_terminal: &mut dnu,
+            },
+        );
+        for i in 0..=k {
+            self.dz[i] += self.dz_c[i];
+        }
+        for i in 0..k {
+            self.y_dynamics_new[i] += self.y_dynamics_c[i];
+        }
+        self.y_initial_new += dy0;
+        self.y_terminal_new += dnu;
+        for (j, core) in qp.slack_core.iter().enumerate() {
+            let coupled = core.map_or(0.0, |(i, l)| self.h_sv[j] * self.dz_c[i][l]);
+            let correction = -(self.e_sigma[j] + coupled) / self.h_ss[j];
+            self.d_sigma[j] += correction;
+            // Reuse e_sigma for the slack's correction (read by the rows below).
+            self.e_sigma[j] = correction;
+        }
+        for (j, row) in qp.inequalities.iter().enumerate() {
+            let gz = row.core.map_or(0.0, |(i, l)| row.coef * self.dz_c[i][l])
+                + row.slack.map_or(0.0, |m| row.slack_coef * self.e_sigma[m]);
+            self.ds[j] -= gz;
+        }
+    }
+
+    /// `P + Gᵀ W G` in stage form, the slacks eliminated, and its Riccati factorization.
+    ///
+    /// A slack `σ` and its variable `l` share the rows `R`; eliminating `σ` adds
+    /// `Σ_R W c² - (Σ_R W c c_σ)² / Σ_R W c_σ²` to `l`'s diagonal. Written so, the
+    /// difference cancels catastrophically once a bound is active (`W ~ 1e12` next to an
+    /// `O(1)` result) and the iterations stall; the Lagrange identity gives the same
+    /// value as a sum of non-negative terms, `Σ_{p<q} W_p W_q (c_p c_σq - c_q c_σp)² /
+    /// Σ_R W c_σ²`, which is what is added.
+    fn factor(&mut self, qp: &StageQp) -> Result<(), FactorError> {
+        self.newton_h.copy_from_slice(&qp.hessian);
+        for (row, &w) in qp.inequalities.iter().zip(&self.w) {
+            if let (Some((i, l)), None) = (row.core, row.slack) {
+                self.newton_h[i][(l, l)] += w * row.coef * row.coef;
+            }
+        }
+        for (j, rows) in qp.slack_rows.iter().enumerate() {
+            let rows = rows.iter().take_while(|&&r| r != usize::MAX);
+            let (mut h_ss, mut h_sv, mut pairs) = (0.0, 0.0, 0.0);
+            for (n, &p) in rows.clone().enumerate() {
+                let (rp, wp) = (&qp.inequalities[p], self.w[p]);
+                let cp = if rp.core.is_some() { rp.coef } else { 0.0 };
+                h_ss += wp * rp.slack_coef * rp.slack_coef;
+                h_sv += wp * cp * rp.slack_coef;
+                for &q in rows.clone().skip(n + 1) {
+                    let (rq, wq) = (&qp.inequalities[q], self.w[q]);
+                    let cq = if rq.core.is_some() { rq.coef } else { 0.0 };
+                    let minor = cp * rq.slack_coef - cq * rp.slack_coef;
+                    pairs += wp * wq * minor * minor;
+                }
+            }
+            self.h_ss[j] = h_ss;
+            self.h_sv[j] = h_sv;
+            if let Some((i, l)) = qp.slack_core[j] {
+                self.newton_h[i][(l, l)] += pairs / h_ss;
             }
         }
         self.riccati
@@ -535,9 +743,9 @@ fn head(v: &mut Vector6<f64>, add: &Vector4<f64>) {
     h += add;
 }
 
-fn failed(e: FactorError) -> Outcome {
-    Outcome::Failed(match e {
+fn describe(e: FactorError) -> String {
+    match e {
         FactorError::ControlBlock(i) => format!("control block of step {i} not positive definite"),
         FactorError::Terminal => "terminal Schur complement not positive definite".into(),
-    })
+    }
 }

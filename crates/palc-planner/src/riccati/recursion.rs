@@ -32,6 +32,11 @@ use super::stage_qp::{Dynamics, NX};
 /// keeps the recursion defined when the acceleration has no cost of its own.
 const CONTROL_REGULARIZATION: f64 = 1e-10;
 
+/// Newton steps on the terminal multiplier after the first forward pass, at most.
+const TERMINAL_REFINEMENTS: usize = 2;
+/// Terminal residual (relative to `1 + ‖e‖∞`) below which no refinement is done.
+const TERMINAL_TOLERANCE: f64 = 1e-13;
+
 /// Why a factorization failed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum FactorError {
@@ -77,6 +82,7 @@ pub(crate) struct Riccati {
     gamma: Vec<Matrix4<f64>>,
     bt_gamma: Vec<Matrix2x4<f64>>,
     neg_w0_inv: Matrix4<f64>,
+    terminal: Matrix4<f64>,
     p_vec: Vec<Vector4<f64>>,
     k_vec: Vec<Vector2<f64>>,
 }
@@ -105,6 +111,7 @@ impl Riccati {
     ) -> Result<(), FactorError> {
         let k = self.k;
         self.m = m;
+        self.terminal = *terminal;
         self.p[k] = h[k].fixed_view::<4, 4>(0, 0).into_owned();
         self.gamma[k] = terminal.transpose();
         let mut w = Matrix4::<f64>::zeros();
@@ -158,7 +165,7 @@ impl Riccati {
     }
 
     /// Solves the Newton system of the last [`factor`](Self::factor) for `rhs`.
-    pub fn solve(&mut self, dynamics: &[Dynamics], rhs: &Rhs<'_>, out: Step<'_>) {
+    pub fn solve(&mut self, dynamics: &[Dynamics], rhs: &Rhs<'_>, mut out: Step<'_>) {
         let k = self.k;
         self.p_vec[k] = rhs.linear[k].fixed_rows::<4>(0).into_owned();
         let mut w = -rhs.terminal;
@@ -177,6 +184,28 @@ impl Riccati {
         for j in self.m..NX {
             nu[j] = 0.0;
         }
+        // The terminal residual `E x_K - e` is the gradient `Γ_0ᵀx̂_0 + W_0 ν + w_0` of the
+        // dual function in `ν`: once the active bounds make `-W_0` ill-conditioned, a
+        // Newton step on it (forward pass only) restores the terminal rows, which the
+        // interior point cannot otherwise correct.
+        let scale = 1.0 + rhs.terminal.amax();
+        for _ in 0..=TERMINAL_REFINEMENTS {
+            self.forward(dynamics, rhs, &nu, &mut out);
+            let x_k = out.z[self.k].fixed_rows::<4>(0).into_owned();
+            let mut residual = self.terminal * x_k - rhs.terminal;
+            for j in self.m..NX {
+                residual[j] = 0.0;
+            }
+            if residual.amax() <= TERMINAL_TOLERANCE * scale {
+                break;
+            }
+            nu += self.neg_w0_inv * residual;
+        }
+    }
+
+    /// The forward pass for a given `ν`: controls, states and multipliers.
+    fn forward(&self, dynamics: &[Dynamics], rhs: &Rhs<'_>, nu: &Vector4<f64>, out: &mut Step<'_>) {
+        let k = self.k;
         let mut x = rhs.initial;
         *out.y_initial = -(self.p[0] * x + self.p_vec[0] + self.gamma[0] * nu);
         for i in 0..k {
@@ -188,6 +217,6 @@ impl Riccati {
             out.y_dynamics[i] = -(self.p[i + 1] * x + self.p_vec[i + 1] + self.gamma[i + 1] * nu);
         }
         out.z[k] = Vector6::new(x[0], x[1], x[2], x[3], 0.0, 0.0);
-        *out.y_terminal = nu;
+        *out.y_terminal = *nu;
     }
 }

@@ -11,6 +11,9 @@ use nalgebra::{Matrix4, Matrix4x2, Matrix6, Vector4, Vector6};
 
 use crate::qp::QpData;
 
+/// Most inequality rows one slack may appear in (soft mode uses 3: above, below, `σ >= 0`).
+pub(crate) const MAX_SLACK_ROWS: usize = 4;
+
 /// States per step.
 pub(crate) const NX: usize = 4;
 /// Variables per stage (state and control).
@@ -60,6 +63,9 @@ pub(crate) struct StageQp {
     pub slack_cost: Vec<f64>,
     /// The stage variable each slack is tied to by its rows, if any.
     pub slack_core: Vec<Option<(usize, usize)>>,
+    /// The inequality rows of each slack (at most [`MAX_SLACK_ROWS`]; unused entries
+    /// `usize::MAX`).
+    pub slack_rows: Vec<[usize; MAX_SLACK_ROWS]>,
     /// Inequality rows in the order of the QP's rows.
     pub inequalities: Vec<Inequality>,
     /// Equality rows `m_eq = 4 + 4K + m`.
@@ -206,10 +212,15 @@ impl StageQp {
                 }
             }
         }
-        let mut slack_rows = vec![0usize; n_slack];
+        self.slack_rows.clear();
+        self.slack_rows
+            .resize(n_slack, [usize::MAX; MAX_SLACK_ROWS]);
         for (row, ineq) in self.inequalities.iter().enumerate() {
             let Some(j) = ineq.slack else { continue };
-            slack_rows[j] += 1;
+            let Some(free) = self.slack_rows[j].iter_mut().find(|r| **r == usize::MAX) else {
+                return Err(format!("slack {j} is in more than {MAX_SLACK_ROWS} rows"));
+            };
+            *free = row;
             if let Some(core) = ineq.core {
                 match self.slack_core[j] {
                     None => self.slack_core[j] = Some(core),
@@ -222,8 +233,17 @@ impl StageQp {
                 }
             }
         }
-        if let Some(j) = slack_rows.iter().position(|&n| n == 0) {
+        if let Some(j) = self.slack_rows.iter().position(|r| r[0] == usize::MAX) {
             return Err(format!("slack {j} has no inequality row"));
+        }
+        for (row, ineq) in self.inequalities.iter().enumerate() {
+            if let (Some(core), None) = (ineq.core, ineq.slack) {
+                if self.slack_core.contains(&Some(core)) {
+                    return Err(format!(
+                        "row {row} bounds a softly bounded variable without its slack"
+                    ));
+                }
+            }
         }
         Ok(())
     }
