@@ -9,10 +9,10 @@
 
 mod common;
 
-use common::{convex_problem, lane_change};
+use common::{convex_column, convex_problem, lane_change};
 use palc_planner::{
     Backend, LateralBound, LateralBoundsMode, Plan, PlanError, Planner, PlannerConfig, Problem,
-    SolverSettings,
+    SolverSettings, State, Tracking, Weights,
 };
 use proptest::prelude::*;
 
@@ -59,6 +59,81 @@ fn reference_config(config: &PlannerConfig) -> PlannerConfig {
     }
 }
 
+/// A lane change through a learned zone: per step a centre drifting from lane 0 to
+/// lane 1 plus noise and a half-width of 0.1-2 m, crossed (`min > max`) at some steps
+/// in soft mode, random convex weights, optional tracking of the zone centre (Eq. 26).
+fn zone_problem() -> impl Strategy<Value = (PlannerConfig, Problem)> {
+    (
+        20usize..=40,
+        prop_oneof![Just(0.1), Just(0.2)],
+        prop::bool::ANY,
+        12.0..30.0f64,
+    )
+        .prop_flat_map(|(k, dt, soft, speed)| {
+            (
+                Just((k, dt, soft, speed)),
+                prop::collection::vec(convex_column(), k),
+                prop::collection::vec(
+                    (-1.0..1.0f64, 0.1..2.0f64, prop::bool::weighted(0.1)),
+                    k + 1,
+                ),
+                prop::option::of(0.1..20.0f64),
+            )
+        })
+        .prop_map(|((k, dt, soft, speed), columns, zone, tracking)| {
+            let config = PlannerConfig {
+                horizon: k,
+                dt,
+                lateral_bounds_mode: if soft {
+                    LateralBoundsMode::Soft { weight: 100.0 }
+                } else {
+                    LateralBoundsMode::Hard
+                },
+                ..PlannerConfig::default()
+            };
+            let mut problem = lane_change(&config, speed);
+            problem.weights = Weights::from_columns(columns);
+            let centre = |i: usize, noise: f64| {
+                let x = i as f64 / k as f64;
+                3.5 * x * x * (3.0 - 2.0 * x) + noise
+            };
+            problem.lateral_bounds = zone
+                .iter()
+                .enumerate()
+                .map(|(i, &(noise, half, crossed))| {
+                    let c = centre(i, noise);
+                    let (min, max) = (c - half, c + half);
+                    // Steps 0 and K hold the fixed lateral positions (hard mode refuses
+                    // a boundary outside the zone before solving).
+                    if i == 0 || i == k {
+                        return Some(LateralBound::new(-1.75, 5.25));
+                    }
+                    Some(if soft && crossed {
+                        LateralBound::new(max, min)
+                    } else {
+                        LateralBound::new(min, max)
+                    })
+                })
+                .collect();
+            problem.tracking = tracking.map(|q_l| Tracking {
+                weights: [0.0, 0.0, q_l, 0.0],
+                reference: zone
+                    .iter()
+                    .enumerate()
+                    .map(|(i, &(noise, _, _))| {
+                        Some(State {
+                            s: 0.0,
+                            v: 0.0,
+                            l: centre(i, noise),
+                            phi: 0.0,
+                        })
+                    })
+                    .collect(),
+            });
+            (config, problem)
+        })
+}
+
 /// The trajectory tolerance of the module docs, `[s, v, l, φ, a, δ]`.
 const TRAJECTORY_TOLERANCE: [f64; 6] = [1e-3; 6];
 
@@ -84,6 +159,29 @@ proptest! {
         }
         for (x, y) in riccati.lateral_violation.iter().zip(&clarabel.lateral_violation) {
             prop_assert!((x - y).abs() <= 1e-4, "slack {} vs {}", x, y);
+        }
+    }
+
+    /// Learned-zone problems as the lesson-learning loop builds them: narrow zones that
+    /// drift, cross (empty in soft mode) and pull, with the zone-centre tracking of
+    /// Eq. 26. Both backends reach the same verdict, and the same objective when solved.
+    #[test]
+    fn both_backends_agree_on_learned_zone_problems(
+        (config, problem) in zone_problem(),
+    ) {
+        let riccati = plan_with(Backend::Riccati, &config, &problem);
+        let clarabel = plan_with(Backend::Clarabel, &reference_config(&config), &problem);
+        match (&riccati, &clarabel) {
+            (Ok(r), Ok(c)) => {
+                let scale = 1.0 + c.objective.abs();
+                prop_assert!(
+                    (r.objective - c.objective).abs() <= 1e-6 * scale,
+                    "objective riccati {} vs clarabel {}", r.objective, c.objective
+                );
+            }
+            (Err(PlanError::Infeasible { .. }), Err(PlanError::Infeasible { .. })) => {}
+            (Err(PlanError::ZoneTooNarrow { .. }), Err(PlanError::ZoneTooNarrow { .. })) => {}
+            _ => prop_assert!(false, "riccati {:?} vs clarabel {:?}", riccati.map(|p| p.objective), clarabel.map(|p| p.objective)),
         }
     }
 
