@@ -19,7 +19,7 @@
 //! is checked at every iterate; when the constraints are inconsistent the multipliers
 //! of an infeasible-start method grow along such a ray.
 
-use nalgebra::{Matrix6, Vector4, Vector6};
+use nalgebra::{Vector4, Vector6};
 
 use super::recursion::{FactorError, Rhs, Riccati, Step};
 use super::stage_qp::{NX, StageQp};
@@ -43,7 +43,7 @@ const REFINE_BELOW: f64 = 1e-5;
 /// Newton steps lose all accuracy.
 const STAGNATION: u32 = 5;
 /// Fraction of the step to the boundary of the positive orthant.
-const STEP_FRACTION: f64 = 0.99;
+const STEP_FRACTION: f64 = 0.995;
 
 /// Stopping tolerances (from [`SolverSettings`](crate::SolverSettings)).
 #[derive(Debug, Clone, Copy)]
@@ -137,7 +137,9 @@ pub(crate) struct Ipm {
     inv_s: Vec<f64>,
     xi: Vec<f64>,
     rc: Vec<f64>,
-    newton_h: Vec<Matrix6<f64>>,
+    /// `diag(Gᵀ W G)` after the slack elimination, per stage: the Newton Hessian is
+    /// the cost block plus this diagonal.
+    newton_diag: Vec<Vector6<f64>>,
     h_ss: Vec<f64>,
     h_sv: Vec<f64>,
     g: Vec<Vector6<f64>>,
@@ -220,8 +222,8 @@ impl Ipm {
             v.clear();
             v.resize(m_in, 0.0);
         }
-        self.newton_h.clear();
-        self.newton_h.resize(k + 1, Matrix6::zeros());
+        self.newton_diag.clear();
+        self.newton_diag.resize(k + 1, Vector6::zeros());
         let b = &mut self.best_iterate;
         b.z.clear();
         b.z.resize(k + 1, Vector6::zeros());
@@ -269,7 +271,9 @@ impl Ipm {
                 return Outcome::PrimalInfeasible;
             }
             let merit = measures.merit(tol);
-            if merit < self.best_merit {
+            // Only an iterate that meets the reduced tolerances can be returned.
+            let candidate = measures.meets(REDUCED_GAP, REDUCED_GAP, REDUCED_FEAS);
+            if candidate && merit < self.best_merit {
                 self.save_best(merit, measures);
                 since_best = 0;
             } else {
@@ -470,9 +474,9 @@ impl Ipm {
             let d = &qp.dynamics[i];
             let dy = self.y_dynamics_new[i] - self.y_dynamics[i];
             head(&mut self.e[i + 1], &dy);
-            head(&mut self.e[i], &-d.a.tr_mul(&dy));
+            head(&mut self.e[i], &-d.sparse.a_tr_mul(&dy));
             let mut tail = self.e[i].fixed_rows_mut::<2>(4);
-            tail -= d.b.tr_mul(&dy);
+            tail -= d.sparse.b_tr_mul(&dy);
         }
         let dnu = self.y_terminal_new - self.y_terminal;
         head(&mut self.e[k], &qp.terminal.tr_mul(&dnu));
@@ -537,10 +541,10 @@ impl Ipm {
     /// value as a sum of non-negative terms, `Σ_{p<q} W_p W_q (c_p c_σq - c_q c_σp)² /
     /// Σ_R W c_σ²`, which is what is added.
     fn factor(&mut self, qp: &StageQp) -> Result<(), FactorError> {
-        self.newton_h.copy_from_slice(&qp.hessian);
+        self.newton_diag.fill(Vector6::zeros());
         for (row, &w) in qp.inequalities.iter().zip(&self.w) {
             if let (Some((i, l)), None) = (row.core, row.slack) {
-                self.newton_h[i][(l, l)] += w * row.coef * row.coef;
+                self.newton_diag[i][l] += w * row.coef * row.coef;
             }
         }
         for (j, rows) in qp.slack_rows.iter().enumerate() {
@@ -561,11 +565,16 @@ impl Ipm {
             self.h_ss[j] = h_ss;
             self.h_sv[j] = h_sv;
             if let Some((i, l)) = qp.slack_core[j] {
-                self.newton_h[i][(l, l)] += pairs / h_ss;
+                self.newton_diag[i][l] += pairs / h_ss;
             }
         }
-        self.riccati
-            .factor(&self.newton_h, &qp.dynamics, &qp.terminal, qp.terminal_rows)
+        self.riccati.factor(
+            &qp.hessian,
+            &self.newton_diag,
+            &qp.dynamics,
+            &qp.terminal,
+            qp.terminal_rows,
+        )
     }
 
     /// Solves the factored Newton system for the current `ξ` and residuals:
@@ -632,9 +641,9 @@ impl Ipm {
             let d = &qp.dynamics[i];
             let y = &self.y_dynamics[i];
             head(&mut self.r_dual[i + 1], y);
-            head(&mut self.r_dual[i], &-d.a.tr_mul(y));
+            head(&mut self.r_dual[i], &-d.sparse.a_tr_mul(y));
             let mut tail = self.r_dual[i].fixed_rows_mut::<2>(4);
-            tail -= d.b.tr_mul(y);
+            tail -= d.sparse.b_tr_mul(y);
         }
         head(&mut self.r_dual[k], &qp.terminal.tr_mul(&self.y_terminal));
         for (row, &l) in qp.inequalities.iter().zip(&self.lambda) {
@@ -684,7 +693,10 @@ impl Ipm {
             let d = &qp.dynamics[i];
             let x = self.z[i].fixed_rows::<4>(0);
             let u = self.z[i].fixed_rows::<2>(4);
-            self.r_dynamics[i] = self.z[i + 1].fixed_rows::<4>(0) - d.a * x - d.b * u - d.c;
+            self.r_dynamics[i] = self.z[i + 1].fixed_rows::<4>(0)
+                - d.sparse.a_mul(&x.into_owned())
+                - d.sparse.b_mul(&u.into_owned())
+                - d.c;
         }
         self.r_terminal = qp.terminal * self.z[k].fixed_rows::<4>(0) - qp.terminal_rhs;
         for j in m..NX {

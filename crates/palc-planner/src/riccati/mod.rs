@@ -12,6 +12,7 @@
 
 mod ipm;
 mod recursion;
+mod sparse;
 mod stage_qp;
 
 use crate::backend::{RawSolution, RawStatus};

@@ -34,8 +34,9 @@ const CONTROL_REGULARIZATION: f64 = 1e-10;
 
 /// Newton steps on the terminal multiplier after the first forward pass, at most.
 const TERMINAL_REFINEMENTS: usize = 2;
-/// Terminal residual (relative to `1 + ‖e‖∞`) below which no refinement is done.
-const TERMINAL_TOLERANCE: f64 = 1e-13;
+/// Terminal residual (relative to `1 + ‖x_K‖∞ + ‖e‖∞`) below which no refinement is
+/// done: rounding in the forward pass alone reaches about 1e-14.
+const TERMINAL_TOLERANCE: f64 = 1e-12;
 
 /// Why a factorization failed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -100,11 +101,12 @@ impl Riccati {
         self.k_vec.resize(k, Vector2::zeros());
     }
 
-    /// Backward pass over the Hessian blocks `h` (`K + 1`), dynamics and the `m`
-    /// terminal rows `terminal` (rows `0..m` used).
+    /// Backward pass over the Hessian blocks `h + diag(d)` (`K + 1`), dynamics and the
+    /// `m` terminal rows `terminal` (rows `0..m` used).
     pub fn factor(
         &mut self,
         h: &[Matrix6<f64>],
+        d: &[Vector6<f64>],
         dynamics: &[Dynamics],
         terminal: &Matrix4<f64>,
         m: usize,
@@ -113,15 +115,21 @@ impl Riccati {
         self.m = m;
         self.terminal = *terminal;
         self.p[k] = h[k].fixed_view::<4, 4>(0, 0).into_owned();
+        for j in 0..NX {
+            self.p[k][(j, j)] += d[k][j];
+        }
         self.gamma[k] = terminal.transpose();
         let mut w = Matrix4::<f64>::zeros();
         for i in (0..k).rev() {
-            let Dynamics { a, b, .. } = &dynamics[i];
+            let diag = &d[i];
+            let d = &dynamics[i].sparse;
             let hi = &h[i];
             let p_next = &self.p[i + 1];
-            let pa = p_next * a;
-            let pb = p_next * b;
-            let mut r_bar = hi.fixed_view::<2, 2>(4, 4) + b.tr_mul(&pb);
+            let pa = d.right_a(p_next);
+            let pb = d.right_b(p_next);
+            let mut r_bar = hi.fixed_view::<2, 2>(4, 4) + d.b_tr_left(&pb);
+            r_bar[(0, 0)] += diag[4];
+            r_bar[(1, 1)] += diag[5];
             let scale = r_bar[(0, 0)].abs().max(r_bar[(1, 1)].abs());
             let reg = CONTROL_REGULARIZATION + 1e-13 * scale;
             r_bar[(0, 0)] += reg;
@@ -134,12 +142,16 @@ impl Riccati {
                 .flatten()
                 .filter(|m| m.iter().all(|x| x.is_finite()))
                 .ok_or(FactorError::ControlBlock(i))?;
-            let s_bar = hi.fixed_view::<4, 2>(0, 4).transpose() + b.tr_mul(&pa);
+            let s_bar = hi.fixed_view::<4, 2>(0, 4).transpose() + d.b_tr_left(&pa);
             let gain = -(r_inv * s_bar);
-            let mut p = hi.fixed_view::<4, 4>(0, 0) + a.tr_mul(&pa) + s_bar.tr_mul(&gain);
+            let mut p = hi.fixed_view::<4, 4>(0, 0) + d.a_tr_left(&pa) + s_bar.tr_mul(&gain);
+            for j in 0..NX {
+                p[(j, j)] += diag[j];
+            }
             p = (p + p.transpose()) * 0.5;
-            let bt_gamma = b.tr_mul(&self.gamma[i + 1]);
-            self.gamma[i] = (a + b * gain).tr_mul(&self.gamma[i + 1]);
+            // Γ_i = (A + BK)ᵀ Γ = AᵀΓ + Kᵀ (BᵀΓ).
+            let bt_gamma = d.b_tr_left(&self.gamma[i + 1]);
+            self.gamma[i] = d.a_tr_left(&self.gamma[i + 1]) + gain.tr_mul(&bt_gamma);
             w -= bt_gamma.tr_mul(&(r_inv * bt_gamma));
             self.p[i] = p;
             self.gain[i] = gain;
@@ -170,13 +182,13 @@ impl Riccati {
         self.p_vec[k] = rhs.linear[k].fixed_rows::<4>(0).into_owned();
         let mut w = -rhs.terminal;
         for i in (0..k).rev() {
-            let Dynamics { a, b, .. } = &dynamics[i];
+            let d = &dynamics[i].sparse;
             let f = &rhs.offsets[i];
             let pf = self.p[i + 1] * f + self.p_vec[i + 1];
-            let r_bar = rhs.linear[i].fixed_rows::<2>(4) + b.tr_mul(&pf);
+            let r_bar = rhs.linear[i].fixed_rows::<2>(4) + d.b_tr_mul(&pf);
             let kv = -(self.r_inv[i] * r_bar);
             self.p_vec[i] =
-                rhs.linear[i].fixed_rows::<4>(0) + a.tr_mul(&pf) + self.gain[i].tr_mul(&r_bar);
+                rhs.linear[i].fixed_rows::<4>(0) + d.a_tr_mul(&pf) + self.gain[i].tr_mul(&r_bar);
             w += self.gamma[i + 1].tr_mul(f) + self.bt_gamma[i].tr_mul(&kv);
             self.k_vec[i] = kv;
         }
@@ -188,10 +200,10 @@ impl Riccati {
         // dual function in `ν`: once the active bounds make `-W_0` ill-conditioned, a
         // Newton step on it (forward pass only) restores the terminal rows, which the
         // interior point cannot otherwise correct.
-        let scale = 1.0 + rhs.terminal.amax();
         for _ in 0..=TERMINAL_REFINEMENTS {
             self.forward(dynamics, rhs, &nu, &mut out);
             let x_k = out.z[self.k].fixed_rows::<4>(0).into_owned();
+            let scale = 1.0 + x_k.amax() + rhs.terminal.amax();
             let mut residual = self.terminal * x_k - rhs.terminal;
             for j in self.m..NX {
                 residual[j] = 0.0;
@@ -209,11 +221,11 @@ impl Riccati {
         let mut x = rhs.initial;
         *out.y_initial = -(self.p[0] * x + self.p_vec[0] + self.gamma[0] * nu);
         for i in 0..k {
-            let Dynamics { a, b, .. } = &dynamics[i];
+            let d = &dynamics[i].sparse;
             let u = self.gain[i] * x + self.k_vec[i] - self.r_inv[i] * (self.bt_gamma[i] * nu);
             out.z[i].fixed_rows_mut::<4>(0).copy_from(&x);
             out.z[i].fixed_rows_mut::<2>(4).copy_from(&u);
-            x = a * x + b * u + rhs.offsets[i];
+            x = d.a_mul(&x) + d.b_mul(&u) + rhs.offsets[i];
             out.y_dynamics[i] = -(self.p[i + 1] * x + self.p_vec[i + 1] + self.gamma[i + 1] * nu);
         }
         out.z[k] = Vector6::new(x[0], x[1], x[2], x[3], 0.0, 0.0);

@@ -9,6 +9,7 @@
 
 use nalgebra::{Matrix4, Matrix4x2, Matrix6, Vector4, Vector6};
 
+use super::sparse::StepDynamics;
 use crate::qp::QpData;
 
 /// Most inequality rows one slack may appear in (soft mode uses 3: above, below, `σ >= 0`).
@@ -19,12 +20,14 @@ pub(crate) const NX: usize = 4;
 /// Variables per stage (state and control).
 pub(crate) const NZ: usize = 6;
 
-/// `X_{i+1} = a X_i + b U_i + c` (Eqs. 11-14).
+/// `X_{i+1} = a X_i + b U_i + c` (Eqs. 11-14); `sparse` holds `a` and `b` by their
+/// non-zero entries for the products of the recursion.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Dynamics {
     pub a: Matrix4<f64>,
     pub b: Matrix4x2<f64>,
     pub c: Vector4<f64>,
+    pub sparse: StepDynamics,
 }
 
 /// One inequality row `coef · z[core] + slack_coef · σ[slack] <= h`.
@@ -169,9 +172,11 @@ impl StageQp {
             self.x0[r] = data.b[r];
         }
         for step in 0..k {
+            let d = &mut self.dynamics[step];
             for comp in 0..NX {
-                self.dynamics[step].c[comp] = data.b[NX + NX * step + comp];
+                d.c[comp] = data.b[NX + NX * step + comp];
             }
+            d.sparse = StepDynamics::new(&d.a, &d.b);
         }
         for j in 0..self.terminal_rows {
             self.terminal_rhs[j] = data.b[first_terminal + j];
