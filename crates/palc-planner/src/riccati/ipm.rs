@@ -229,10 +229,8 @@ impl Ipm {
         b.z.resize(k + 1, Vector6::zeros());
         b.y_dynamics.clear();
         b.y_dynamics.resize(k, Vector4::zeros());
-        for v in [&mut b.sigma] {
-            v.clear();
-            v.resize(n_slack, 0.0);
-        }
+        b.sigma.clear();
+        b.sigma.resize(n_slack, 0.0);
         for v in [&mut b.s, &mut b.lambda] {
             v.clear();
             v.resize(m_in, 0.0);
