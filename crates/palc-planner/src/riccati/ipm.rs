@@ -34,9 +34,9 @@ const INFEASIBILITY_TOLERANCE: f64 = 1e-8;
 const REDUCED_GAP: f64 = 5e-5;
 const REDUCED_FEAS: f64 = 1e-4;
 const REDUCED_INFEASIBILITY: f64 = 5e-5;
-/// Measures (relative dual residual and gap) below which the corrector step gets one
-/// step of iterative refinement.
-const REFINE_BELOW: f64 = 1e-5;
+/// A step that leaves more than this many times the `(1 - α)` share of the dual
+/// residual that an exact Newton step leaves switches iterative refinement on.
+const REFINE_SHORTFALL: f64 = 10.0;
 /// Iterations without a better iterate, once one meets the reduced tolerances, after
 /// which the best is returned (`AlmostSolved`): a healthy interior point improves at
 /// every step near the optimum, and continuing only lets `W = λ / s` grow until the
@@ -125,11 +125,11 @@ pub(crate) struct Ipm {
     pub lambda: Vec<f64>,
     pub iterations: u32,
     // Residuals.
-    pz: Vec<Vector6<f64>>,
+    /// `Pz + q` per stage.
+    grad: Vec<Vector6<f64>>,
     r_dual: Vec<Vector6<f64>>,
     r_dual_sigma: Vec<f64>,
     r_initial: Vector4<f64>,
-    r_dynamics: Vec<Vector4<f64>>,
     r_terminal: Vector4<f64>,
     r_in: Vec<f64>,
     // Newton system.
@@ -175,7 +175,7 @@ impl Ipm {
         let (k, n_slack, m_in) = (qp.k, qp.slack_cost.len(), qp.inequalities.len());
         for v in [
             &mut self.z,
-            &mut self.pz,
+            &mut self.grad,
             &mut self.r_dual,
             &mut self.g,
             &mut self.dz,
@@ -187,7 +187,6 @@ impl Ipm {
         }
         for v in [
             &mut self.y_dynamics,
-            &mut self.r_dynamics,
             &mut self.offsets,
             &mut self.y_dynamics_new,
             &mut self.zero_offsets,
@@ -259,6 +258,8 @@ impl Ipm {
         }
         let mut stalled = 0;
         let mut since_best = 0;
+        let mut refining = false;
+        let mut previous = None;
         self.best_merit = f64::INFINITY;
         loop {
             let measures = self.residuals(qp);
@@ -290,12 +291,20 @@ impl Ipm {
                 return self.stop(&measures, reason.into());
             }
             self.iterations += 1;
-            // Near the optimum, `W = λ / s` spans many orders of magnitude and the
-            // Newton step loses accuracy in the stationarity rows: refine it then.
-            let refine = measures.res_dual.max(measures.gap_rel) < REFINE_BELOW;
+            // An exact Newton step scales the dual residual by (1 - α). Near the
+            // optimum, `W = λ / s` spans many orders of magnitude and the step loses
+            // accuracy in the stationarity rows; once a step falls short of that
+            // reduction, every later corrector step gets one refinement step.
+            refining |= previous.is_some_and(|(res_dual, alpha): (f64, f64)| {
+                measures.res_dual > 0.1 * tol.feas
+                    && measures.res_dual > REFINE_SHORTFALL * (1.0 - alpha).max(1e-3) * res_dual
+            });
+            let refine = refining;
             match self.iterate(qp, refine) {
-                Ok(alpha) if alpha < 1e-8 => stalled += 1,
-                Ok(_) => stalled = 0,
+                Ok(alpha) => {
+                    stalled = if alpha < 1e-8 { stalled + 1 } else { 0 };
+                    previous = Some((measures.res_dual, alpha));
+                }
                 Err(e) => return self.stop(&measures, describe(e)),
             }
         }
@@ -350,6 +359,9 @@ impl Ipm {
         for (xi, row) in self.xi.iter_mut().zip(&qp.inequalities) {
             *xi = -row.h;
         }
+        // rc, λ and 1/s are zero here, so the Δλ the step computes is unused noise-free 0.
+        self.rc.fill(0.0);
+        self.inv_s.fill(0.0);
         self.newton_step(qp);
         self.z.copy_from_slice(&self.dz);
         self.sigma.copy_from_slice(&self.d_sigma);
@@ -385,21 +397,18 @@ impl Ipm {
     fn iterate(&mut self, qp: &StageQp, refine: bool) -> Result<f64, FactorError> {
         let m_in = self.s.len() as f64;
         let mut sl = 0.0;
+        // Predictor: r_c = s∘λ, so ξ = λ + W r_in - r_c / s = W r_in.
         for j in 0..self.s.len() {
-            self.inv_s[j] = 1.0 / self.s[j];
-            self.w[j] = self.lambda[j] * self.inv_s[j];
-            sl += self.s[j] * self.lambda[j];
+            let (s, l) = (self.s[j], self.lambda[j]);
+            self.inv_s[j] = 1.0 / s;
+            self.w[j] = l * self.inv_s[j];
+            self.rc[j] = s * l;
+            self.xi[j] = self.w[j] * self.r_in[j];
+            sl += s * l;
         }
         let mu = sl / m_in;
         self.factor(qp)?;
-
-        // Predictor: r_c = s∘λ, so ξ = λ + W r_in - r_c / s = W r_in.
-        for j in 0..self.s.len() {
-            self.rc[j] = self.s[j] * self.lambda[j];
-            self.xi[j] = self.w[j] * self.r_in[j];
-        }
-        self.newton_step(qp);
-        let alpha = self.dual_step_to_boundary();
+        let alpha = self.newton_step(qp);
         let mut mu_affine = 0.0;
         for j in 0..self.s.len() {
             let (ds, dl) = (self.ds[j], self.d_lambda[j]);
@@ -413,12 +422,12 @@ impl Ipm {
             self.rc[j] -= shift;
             self.xi[j] = self.lambda[j] + self.w[j] * self.r_in[j] - self.rc[j] * self.inv_s[j];
         }
-        self.newton_step(qp);
+        let mut alpha = self.newton_step(qp);
         if refine {
-            self.dual_step_to_boundary();
             self.refine(qp);
+            alpha = self.dual_step_to_boundary();
         }
-        let alpha = (STEP_FRACTION * self.dual_step_to_boundary()).min(1.0);
+        let alpha = (STEP_FRACTION * alpha).min(1.0);
 
         for i in 0..self.z.len() {
             self.z[i] += alpha * self.dz[i];
@@ -576,11 +585,11 @@ impl Ipm {
     }
 
     /// Solves the factored Newton system for the current `ξ` and residuals:
-    /// `(P + GᵀWG) Δz + Aᵀ y⁺ = -(Pz + q + Gᵀξ)`, `A Δz = -r_eq`, then `Δs = -r_in - G Δz`.
-    fn newton_step(&mut self, qp: &StageQp) {
-        for i in 0..self.g.len() {
-            self.g[i] = self.pz[i] + qp.linear[i];
-        }
+    /// `(P + GᵀWG) Δz + Aᵀ y⁺ = -(Pz + q + Gᵀξ)`, `A Δz = -r_eq`, then `Δs = -r_in - G Δz`
+    /// and `Δλ = -(r_c + λ Δs) / s`; returns the largest step `α <= 1` that keeps `s`
+    /// and `λ` non-negative.
+    fn newton_step(&mut self, qp: &StageQp) -> f64 {
+        self.g.copy_from_slice(&self.grad);
         self.g_sigma.copy_from_slice(&qp.slack_cost);
         for (row, &xi) in qp.inequalities.iter().zip(&self.xi) {
             if let Some((i, l)) = row.core {
@@ -594,9 +603,6 @@ impl Ipm {
             if let Some((i, l)) = *core {
                 self.g[i][l] -= self.h_sv[j] * self.g_sigma[j] / self.h_ss[j];
             }
-        }
-        for (offset, r) in self.offsets.iter_mut().zip(&self.r_dynamics) {
-            *offset = -r;
         }
         let rhs = Rhs {
             linear: &self.g,
@@ -618,119 +624,114 @@ impl Ipm {
             let coupled = core.map_or(0.0, |(i, l)| self.h_sv[j] * self.dz[i][l]);
             self.d_sigma[j] = -(self.g_sigma[j] + coupled) / self.h_ss[j];
         }
+        let mut alpha = 1.0_f64;
         for (j, row) in qp.inequalities.iter().enumerate() {
             let gz = row.core.map_or(0.0, |(i, l)| row.coef * self.dz[i][l])
                 + row.slack.map_or(0.0, |k| row.slack_coef * self.d_sigma[k]);
-            self.ds[j] = -self.r_in[j] - gz;
+            let ds = -self.r_in[j] - gz;
+            let dl = -(self.rc[j] + self.lambda[j] * ds) * self.inv_s[j];
+            self.ds[j] = ds;
+            self.d_lambda[j] = dl;
+            if ds < 0.0 {
+                alpha = alpha.min(-self.s[j] / ds);
+            }
+            if dl < 0.0 {
+                alpha = alpha.min(-self.lambda[j] / dl);
+            }
         }
+        alpha
     }
 
     /// Residuals and convergence measures of the current iterate.
     fn residuals(&mut self, qp: &StageQp) -> Measures {
         let k = qp.k;
         let m = qp.terminal_rows;
-        // Aᵀy + Gᵀλ into r_dual (stage part) and r_dual_sigma.
+        // Pass over the inequalities: Gᵀλ into r_dual / r_dual_sigma, r_in, hᵀλ, norms.
         for v in self.r_dual.iter_mut() {
             *v = Vector6::zeros();
         }
         self.r_dual_sigma.fill(0.0);
-        head(&mut self.r_dual[0], &self.y_initial);
-        for i in 0..k {
-            let d = &qp.dynamics[i];
-            let y = &self.y_dynamics[i];
-            head(&mut self.r_dual[i + 1], y);
-            head(&mut self.r_dual[i], &-d.sparse.a_tr_mul(y));
-            let mut tail = self.r_dual[i].fixed_rows_mut::<2>(4);
-            tail -= d.sparse.b_tr_mul(y);
-        }
-        head(&mut self.r_dual[k], &qp.terminal.tr_mul(&self.y_terminal));
-        for (row, &l) in qp.inequalities.iter().zip(&self.lambda) {
+        let (mut hl, mut norm_s, mut norm_lambda, mut norm_r_in) = (0.0, 0.0_f64, 0.0_f64, 0.0_f64);
+        for (j, row) in qp.inequalities.iter().enumerate() {
+            let (l, s) = (self.lambda[j], self.s[j]);
+            let mut gz = 0.0;
             if let Some((i, c)) = row.core {
                 self.r_dual[i][c] += row.coef * l;
+                gz += row.coef * self.z[i][c];
             }
-            if let Some(j) = row.slack {
-                self.r_dual_sigma[j] += row.slack_coef * l;
+            if let Some(n) = row.slack {
+                self.r_dual_sigma[n] += row.slack_coef * l;
+                gz += row.slack_coef * self.sigma[n];
             }
+            let r = gz + s - row.h;
+            self.r_in[j] = r;
+            hl += row.h * l;
+            norm_s = norm_s.max(s.abs());
+            norm_lambda = norm_lambda.max(l.abs());
+            norm_r_in = norm_r_in.max(r.abs());
         }
-        let certificate_residual = self
-            .r_dual
-            .iter()
-            .fold(0.0_f64, |n, v| n.max(v.amax()))
-            .max(norm_inf(&self.r_dual_sigma));
+        // Pass over the slacks.
+        let (mut qx, mut certificate_residual, mut dual, mut norm_z) =
+            (0.0, 0.0_f64, 0.0_f64, 0.0_f64);
+        for j in 0..self.sigma.len() {
+            certificate_residual = certificate_residual.max(self.r_dual_sigma[j].abs());
+            qx += qp.slack_cost[j] * self.sigma[j];
+            self.r_dual_sigma[j] += qp.slack_cost[j];
+            dual = dual.max(self.r_dual_sigma[j].abs());
+            norm_z = norm_z.max(self.sigma[j].abs());
+        }
+        // Pass over the stages: Aᵀy, Pz, the dynamics residuals, bᵀy, objectives, norms.
+        self.r_initial = self.z[0].fixed_rows::<4>(0) - qp.x0;
         let mut by = qp.x0.dot(&self.y_initial);
-        for i in 0..k {
-            by += qp.dynamics[i].c.dot(&self.y_dynamics[i]);
+        let mut norm_y = self.y_initial.amax().max(self.y_terminal.amax());
+        let mut primal = self.r_initial.amax().max(norm_r_in);
+        let mut xpx = 0.0;
+        for i in 0..=k {
+            let incoming = if i == 0 {
+                self.y_initial
+            } else {
+                self.y_dynamics[i - 1]
+            };
+            head(&mut self.r_dual[i], &incoming);
+            if i < k {
+                let d = &qp.dynamics[i];
+                let y = self.y_dynamics[i];
+                head(&mut self.r_dual[i], &-d.sparse.a_tr_mul(&y));
+                let mut tail = self.r_dual[i].fixed_rows_mut::<2>(4);
+                tail -= d.sparse.b_tr_mul(&y);
+                by += d.c.dot(&y);
+                norm_y = norm_y.max(y.amax());
+                let x = self.z[i].fixed_rows::<4>(0).into_owned();
+                let u = self.z[i].fixed_rows::<2>(4).into_owned();
+                let r = self.z[i + 1].fixed_rows::<4>(0)
+                    - d.sparse.a_mul(&x)
+                    - d.sparse.b_mul(&u)
+                    - d.c;
+                primal = primal.max(r.amax());
+                self.offsets[i] = -r;
+            } else {
+                head(&mut self.r_dual[k], &qp.terminal.tr_mul(&self.y_terminal));
+            }
+            certificate_residual = certificate_residual.max(self.r_dual[i].amax());
+            let pz = qp.hessian[i] * self.z[i];
+            xpx += self.z[i].dot(&pz);
+            qx += qp.linear[i].dot(&self.z[i]);
+            let grad = pz + qp.linear[i];
+            self.r_dual[i] += grad;
+            self.grad[i] = grad;
+            dual = dual.max(self.r_dual[i].amax());
+            norm_z = norm_z.max(self.z[i].amax());
         }
         for j in 0..m {
             by += qp.terminal_rhs[j] * self.y_terminal[j];
-        }
-        let hl: f64 = qp
-            .inequalities
-            .iter()
-            .zip(&self.lambda)
-            .map(|(r, l)| r.h * l)
-            .sum();
-
-        // Dual residual Pz + q + Aᵀy + Gᵀλ and the objectives.
-        let mut xpx = 0.0;
-        let mut qx = 0.0;
-        for i in 0..=k {
-            self.pz[i] = qp.hessian[i] * self.z[i];
-            xpx += self.z[i].dot(&self.pz[i]);
-            qx += qp.linear[i].dot(&self.z[i]);
-            self.r_dual[i] += self.pz[i] + qp.linear[i];
-        }
-        for j in 0..self.sigma.len() {
-            qx += qp.slack_cost[j] * self.sigma[j];
-            self.r_dual_sigma[j] += qp.slack_cost[j];
-        }
-
-        // Primal residuals.
-        self.r_initial = self.z[0].fixed_rows::<4>(0) - qp.x0;
-        for i in 0..k {
-            let d = &qp.dynamics[i];
-            let x = self.z[i].fixed_rows::<4>(0);
-            let u = self.z[i].fixed_rows::<2>(4);
-            self.r_dynamics[i] = self.z[i + 1].fixed_rows::<4>(0)
-                - d.sparse.a_mul(&x.into_owned())
-                - d.sparse.b_mul(&u.into_owned())
-                - d.c;
         }
         self.r_terminal = qp.terminal * self.z[k].fixed_rows::<4>(0) - qp.terminal_rhs;
         for j in m..NX {
             self.r_terminal[j] = 0.0;
         }
-        for (j, row) in qp.inequalities.iter().enumerate() {
-            let gz = row.core.map_or(0.0, |(i, l)| row.coef * self.z[i][l])
-                + row.slack.map_or(0.0, |k| row.slack_coef * self.sigma[k]);
-            self.r_in[j] = gz + self.s[j] - row.h;
-        }
+        primal = primal.max(self.r_terminal.amax());
+        let norm_y = norm_y.max(norm_lambda);
 
-        let norm_z = self
-            .z
-            .iter()
-            .fold(0.0_f64, |n, v| n.max(v.amax()))
-            .max(norm_inf(&self.sigma));
-        let norm_s = norm_inf(&self.s);
-        let norm_y = self
-            .y_dynamics
-            .iter()
-            .fold(self.y_initial.amax().max(self.y_terminal.amax()), |n, v| {
-                n.max(v.amax())
-            })
-            .max(norm_inf(&self.lambda));
-        let primal = self
-            .r_dynamics
-            .iter()
-            .fold(self.r_initial.amax().max(self.r_terminal.amax()), |n, v| {
-                n.max(v.amax())
-            })
-            .max(norm_inf(&self.r_in));
-        let dual = self
-            .r_dual
-            .iter()
-            .fold(0.0_f64, |n, v| n.max(v.amax()))
-            .max(norm_inf(&self.r_dual_sigma));
         // With the constant, so that the relative gap is relative to the plan's
         // objective and not to terms that cancel against the constant.
         let pobj = 0.5 * xpx + qx + qp.constant;

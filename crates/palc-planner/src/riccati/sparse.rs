@@ -62,7 +62,7 @@ impl StepDynamics {
     }
 
     /// `A x`.
-    #[inline]
+    #[inline(always)]
     pub fn a_mul(&self, x: &Vector4<f64>) -> Vector4<f64> {
         match self {
             Self::Bicycle { ds, dl, .. } => {
@@ -73,7 +73,7 @@ impl StepDynamics {
     }
 
     /// `B u`.
-    #[inline]
+    #[inline(always)]
     pub fn b_mul(&self, u: &Vector2<f64>) -> Vector4<f64> {
         match self {
             Self::Bicycle { bv, bphi, .. } => Vector4::new(0.0, bv * u[0], 0.0, bphi * u[1]),
@@ -82,7 +82,7 @@ impl StepDynamics {
     }
 
     /// `Aᵀ y`.
-    #[inline]
+    #[inline(always)]
     pub fn a_tr_mul(&self, y: &Vector4<f64>) -> Vector4<f64> {
         match self {
             Self::Bicycle { ds, dl, .. } => {
@@ -93,7 +93,7 @@ impl StepDynamics {
     }
 
     /// `Bᵀ y`.
-    #[inline]
+    #[inline(always)]
     pub fn b_tr_mul(&self, y: &Vector4<f64>) -> Vector2<f64> {
         match self {
             Self::Bicycle { bv, bphi, .. } => Vector2::new(bv * y[1], bphi * y[3]),
@@ -102,7 +102,7 @@ impl StepDynamics {
     }
 
     /// `X A`.
-    #[inline]
+    #[inline(always)]
     pub fn right_a(&self, x: &Matrix4<f64>) -> Matrix4<f64> {
         match self {
             Self::Bicycle { ds, dl, .. } => {
@@ -116,7 +116,7 @@ impl StepDynamics {
     }
 
     /// `X B`.
-    #[inline]
+    #[inline(always)]
     pub fn right_b(&self, x: &Matrix4<f64>) -> Matrix4x2<f64> {
         match self {
             Self::Bicycle { bv, bphi, .. } => {
@@ -127,7 +127,7 @@ impl StepDynamics {
     }
 
     /// `Aᵀ X`.
-    #[inline]
+    #[inline(always)]
     pub fn a_tr_left<const C: usize>(&self, x: &SMatrix<f64, 4, C>) -> SMatrix<f64, 4, C> {
         match self {
             Self::Bicycle { ds, dl, .. } => {
@@ -141,7 +141,7 @@ impl StepDynamics {
     }
 
     /// `Bᵀ X`.
-    #[inline]
+    #[inline(always)]
     pub fn b_tr_left<const C: usize>(&self, x: &SMatrix<f64, 4, C>) -> SMatrix<f64, 2, C> {
         match self {
             Self::Bicycle { bv, bphi, .. } => {
