@@ -42,6 +42,9 @@ const REFINE_SHORTFALL: f64 = 10.0;
 /// every step near the optimum, and continuing only lets `W = λ / s` grow until the
 /// Newton steps lose all accuracy.
 const STAGNATION: u32 = 5;
+/// Largest fraction of the step to the boundary, taken when the centring is below
+/// `1 - MAX_STEP_FRACTION`.
+const MAX_STEP_FRACTION: f64 = 0.9999;
 /// Fraction of the step to the boundary of the positive orthant.
 const STEP_FRACTION: f64 = 0.995;
 
@@ -140,7 +143,8 @@ pub(crate) struct Ipm {
     /// `diag(Gᵀ W G)` after the slack elimination, per stage: the Newton Hessian is
     /// the cost block plus this diagonal.
     newton_diag: Vec<Vector6<f64>>,
-    h_ss: Vec<f64>,
+    /// `1 / Σ_R W c_σ²` per slack.
+    inv_h_ss: Vec<f64>,
     h_sv: Vec<f64>,
     g: Vec<Vector6<f64>>,
     g_sigma: Vec<f64>,
@@ -198,7 +202,7 @@ impl Ipm {
         for v in [
             &mut self.sigma,
             &mut self.r_dual_sigma,
-            &mut self.h_ss,
+            &mut self.inv_h_ss,
             &mut self.h_sv,
             &mut self.g_sigma,
             &mut self.d_sigma,
@@ -427,7 +431,9 @@ impl Ipm {
             self.refine(qp);
             alpha = self.dual_step_to_boundary();
         }
-        let alpha = (STEP_FRACTION * alpha).min(1.0);
+        // Bolder steps when the predictor was good (little centring needed).
+        let fraction = (1.0 - centering).clamp(STEP_FRACTION, MAX_STEP_FRACTION);
+        let alpha = (fraction * alpha).min(1.0);
 
         for i in 0..self.z.len() {
             self.z[i] += alpha * self.dz[i];
@@ -456,11 +462,11 @@ impl Ipm {
             let ds = self.ds[j];
             let dl = -(self.rc[j] + self.lambda[j] * ds) * self.inv_s[j];
             self.d_lambda[j] = dl;
-            if ds < 0.0 {
-                alpha = alpha.min(-self.s[j] / ds);
+            if self.s[j] + alpha * ds < 0.0 {
+                alpha = -self.s[j] / ds;
             }
-            if dl < 0.0 {
-                alpha = alpha.min(-self.lambda[j] / dl);
+            if self.lambda[j] + alpha * dl < 0.0 {
+                alpha = -self.lambda[j] / dl;
             }
         }
         alpha
@@ -497,7 +503,7 @@ impl Ipm {
         }
         for (j, core) in qp.slack_core.iter().enumerate() {
             if let Some((i, l)) = *core {
-                self.e[i][l] -= self.h_sv[j] * self.e_sigma[j] / self.h_ss[j];
+                self.e[i][l] -= self.h_sv[j] * self.e_sigma[j] * self.inv_h_ss[j];
             }
         }
         let rhs = Rhs {
@@ -527,7 +533,7 @@ impl Ipm {
         self.y_terminal_new += dnu;
         for (j, core) in qp.slack_core.iter().enumerate() {
             let coupled = core.map_or(0.0, |(i, l)| self.h_sv[j] * self.dz_c[i][l]);
-            let correction = -(self.e_sigma[j] + coupled) / self.h_ss[j];
+            let correction = -(self.e_sigma[j] + coupled) * self.inv_h_ss[j];
             self.d_sigma[j] += correction;
             // Reuse e_sigma for the slack's correction (read by the rows below).
             self.e_sigma[j] = correction;
@@ -569,10 +575,10 @@ impl Ipm {
                     pairs += wp * wq * minor * minor;
                 }
             }
-            self.h_ss[j] = h_ss;
+            self.inv_h_ss[j] = 1.0 / h_ss;
             self.h_sv[j] = h_sv;
             if let Some((i, l)) = qp.slack_core[j] {
-                self.newton_diag[i][l] += pairs / h_ss;
+                self.newton_diag[i][l] += pairs * self.inv_h_ss[j];
             }
         }
         self.riccati.factor(
@@ -601,7 +607,7 @@ impl Ipm {
         }
         for (j, core) in qp.slack_core.iter().enumerate() {
             if let Some((i, l)) = *core {
-                self.g[i][l] -= self.h_sv[j] * self.g_sigma[j] / self.h_ss[j];
+                self.g[i][l] -= self.h_sv[j] * self.g_sigma[j] * self.inv_h_ss[j];
             }
         }
         let rhs = Rhs {
@@ -622,7 +628,7 @@ impl Ipm {
         );
         for (j, core) in qp.slack_core.iter().enumerate() {
             let coupled = core.map_or(0.0, |(i, l)| self.h_sv[j] * self.dz[i][l]);
-            self.d_sigma[j] = -(self.g_sigma[j] + coupled) / self.h_ss[j];
+            self.d_sigma[j] = -(self.g_sigma[j] + coupled) * self.inv_h_ss[j];
         }
         let mut alpha = 1.0_f64;
         for (j, row) in qp.inequalities.iter().enumerate() {
@@ -632,11 +638,12 @@ impl Ipm {
             let dl = -(self.rc[j] + self.lambda[j] * ds) * self.inv_s[j];
             self.ds[j] = ds;
             self.d_lambda[j] = dl;
-            if ds < 0.0 {
-                alpha = alpha.min(-self.s[j] / ds);
+            // Divide only where the bound tightens (rare once α has settled).
+            if self.s[j] + alpha * ds < 0.0 {
+                alpha = -self.s[j] / ds;
             }
-            if dl < 0.0 {
-                alpha = alpha.min(-self.lambda[j] / dl);
+            if self.lambda[j] + alpha * dl < 0.0 {
+                alpha = -self.lambda[j] / dl;
             }
         }
         alpha
