@@ -399,33 +399,64 @@ impl Ipm {
 
     /// One predictor-corrector iteration; returns the step length.
     fn iterate(&mut self, qp: &StageQp, refine: bool) -> Result<f64, FactorError> {
-        let m_in = self.s.len() as f64;
-        let mut sl = 0.0;
+        let n = self.s.len();
+        let m_in = n as f64;
         // Predictor: r_c = s∘λ, so ξ = λ + W r_in - r_c / s = W r_in.
-        for j in 0..self.s.len() {
-            let (s, l) = (self.s[j], self.lambda[j]);
-            self.inv_s[j] = 1.0 / s;
-            self.w[j] = l * self.inv_s[j];
-            self.rc[j] = s * l;
-            self.xi[j] = self.w[j] * self.r_in[j];
-            sl += s * l;
-        }
-        let mu = sl / m_in;
+        let mu = {
+            let Self {
+                s,
+                lambda,
+                inv_s,
+                w,
+                rc,
+                xi,
+                r_in,
+                ..
+            } = self;
+            let (s, lambda, r_in) = (&s[..n], &lambda[..n], &r_in[..n]);
+            let (inv_s, w, rc, xi) = (&mut inv_s[..n], &mut w[..n], &mut rc[..n], &mut xi[..n]);
+            let mut sl = 0.0;
+            for j in 0..n {
+                inv_s[j] = 1.0 / s[j];
+                w[j] = lambda[j] * inv_s[j];
+                rc[j] = s[j] * lambda[j];
+                xi[j] = w[j] * r_in[j];
+                sl += rc[j];
+            }
+            sl / m_in
+        };
         self.factor(qp)?;
         let alpha = self.newton_step(qp);
-        let mut mu_affine = 0.0;
-        for j in 0..self.s.len() {
-            let (ds, dl) = (self.ds[j], self.d_lambda[j]);
-            mu_affine += (self.s[j] + alpha * ds) * (self.lambda[j] + alpha * dl);
+        let centering = {
+            let Self {
+                s,
+                lambda,
+                inv_s,
+                w,
+                rc,
+                xi,
+                r_in,
+                ds,
+                d_lambda,
+                ..
+            } = self;
+            let (s, lambda, r_in, inv_s, w) =
+                (&s[..n], &lambda[..n], &r_in[..n], &inv_s[..n], &w[..n]);
+            let (ds, d_lambda) = (&ds[..n], &d_lambda[..n]);
+            let (rc, xi) = (&mut rc[..n], &mut xi[..n]);
+            let mut mu_affine = 0.0;
+            for j in 0..n {
+                mu_affine += (s[j] + alpha * ds[j]) * (lambda[j] + alpha * d_lambda[j]);
+            }
+            let centering = (mu_affine / m_in / mu).clamp(0.0, 1.0).powi(3);
             // Corrector with centring, from the affine step.
-            self.rc[j] = self.s[j] * self.lambda[j] + ds * dl;
-        }
-        let centering = (mu_affine / m_in / mu).clamp(0.0, 1.0).powi(3);
-        let shift = centering * mu;
-        for j in 0..self.s.len() {
-            self.rc[j] -= shift;
-            self.xi[j] = self.lambda[j] + self.w[j] * self.r_in[j] - self.rc[j] * self.inv_s[j];
-        }
+            let shift = centering * mu;
+            for j in 0..n {
+                rc[j] = s[j] * lambda[j] + ds[j] * d_lambda[j] - shift;
+                xi[j] = lambda[j] + w[j] * r_in[j] - rc[j] * inv_s[j];
+            }
+            centering
+        };
         let mut alpha = self.newton_step(qp);
         if refine {
             self.refine(qp);
@@ -435,20 +466,21 @@ impl Ipm {
         let fraction = (1.0 - centering).clamp(STEP_FRACTION, MAX_STEP_FRACTION);
         let alpha = (fraction * alpha).min(1.0);
 
-        for i in 0..self.z.len() {
-            self.z[i] += alpha * self.dz[i];
+        for (z, dz) in self.z.iter_mut().zip(&self.dz) {
+            *z += alpha * dz;
         }
-        for j in 0..self.sigma.len() {
-            self.sigma[j] += alpha * self.d_sigma[j];
+        for (x, dx) in self.sigma.iter_mut().zip(&self.d_sigma) {
+            *x += alpha * dx;
         }
-        for j in 0..self.s.len() {
-            self.s[j] += alpha * self.ds[j];
-            self.lambda[j] += alpha * self.d_lambda[j];
+        for (x, dx) in self.s.iter_mut().zip(&self.ds) {
+            *x += alpha * dx;
+        }
+        for (x, dx) in self.lambda.iter_mut().zip(&self.d_lambda) {
+            *x += alpha * dx;
         }
         self.y_initial += alpha * (self.y_initial_new - self.y_initial);
-        for i in 0..self.y_dynamics.len() {
-            let step = alpha * (self.y_dynamics_new[i] - self.y_dynamics[i]);
-            self.y_dynamics[i] += step;
+        for (y, y_new) in self.y_dynamics.iter_mut().zip(&self.y_dynamics_new) {
+            *y += alpha * (y_new - *y);
         }
         self.y_terminal += alpha * (self.y_terminal_new - self.y_terminal);
         Ok(alpha)
@@ -597,17 +629,29 @@ impl Ipm {
     fn newton_step(&mut self, qp: &StageQp) -> f64 {
         self.g.copy_from_slice(&self.grad);
         self.g_sigma.copy_from_slice(&qp.slack_cost);
-        for (row, &xi) in qp.inequalities.iter().zip(&self.xi) {
-            if let Some((i, l)) = row.core {
-                self.g[i][l] += row.coef * xi;
+        {
+            let Self {
+                g,
+                g_sigma,
+                xi,
+                h_sv,
+                inv_h_ss,
+                ..
+            } = self;
+            for (row, &xi) in qp.inequalities.iter().zip(xi.iter()) {
+                if let Some((i, l)) = row.core {
+                    g[i][l] += row.coef * xi;
+                }
+                if let Some(j) = row.slack {
+                    g_sigma[j] += row.slack_coef * xi;
+                }
             }
-            if let Some(j) = row.slack {
-                self.g_sigma[j] += row.slack_coef * xi;
-            }
-        }
-        for (j, core) in qp.slack_core.iter().enumerate() {
-            if let Some((i, l)) = *core {
-                self.g[i][l] -= self.h_sv[j] * self.g_sigma[j] * self.inv_h_ss[j];
+            let n = qp.slack_core.len();
+            let (g_sigma, h_sv, inv_h_ss) = (&g_sigma[..n], &h_sv[..n], &inv_h_ss[..n]);
+            for (j, core) in qp.slack_core.iter().enumerate() {
+                if let Some((i, l)) = *core {
+                    g[i][l] -= h_sv[j] * g_sigma[j] * inv_h_ss[j];
+                }
             }
         }
         let rhs = Rhs {
@@ -626,24 +670,56 @@ impl Ipm {
                 y_terminal: &mut self.y_terminal_new,
             },
         );
-        for (j, core) in qp.slack_core.iter().enumerate() {
-            let coupled = core.map_or(0.0, |(i, l)| self.h_sv[j] * self.dz[i][l]);
-            self.d_sigma[j] = -(self.g_sigma[j] + coupled) * self.inv_h_ss[j];
-        }
-        let mut alpha = 1.0_f64;
-        for (j, row) in qp.inequalities.iter().enumerate() {
-            let gz = row.core.map_or(0.0, |(i, l)| row.coef * self.dz[i][l])
-                + row.slack.map_or(0.0, |k| row.slack_coef * self.d_sigma[k]);
-            let ds = -self.r_in[j] - gz;
-            let dl = -(self.rc[j] + self.lambda[j] * ds) * self.inv_s[j];
-            self.ds[j] = ds;
-            self.d_lambda[j] = dl;
-            // Divide only where the bound tightens (rare once α has settled).
-            if self.s[j] + alpha * ds < 0.0 {
-                alpha = -self.s[j] / ds;
+        {
+            let Self {
+                dz,
+                d_sigma,
+                g_sigma,
+                h_sv,
+                inv_h_ss,
+                ..
+            } = self;
+            let n = qp.slack_core.len();
+            let (d_sigma, g_sigma, h_sv, inv_h_ss) =
+                (&mut d_sigma[..n], &g_sigma[..n], &h_sv[..n], &inv_h_ss[..n]);
+            for (j, core) in qp.slack_core.iter().enumerate() {
+                let coupled = core.map_or(0.0, |(i, l)| h_sv[j] * dz[i][l]);
+                d_sigma[j] = -(g_sigma[j] + coupled) * inv_h_ss[j];
             }
-            if self.lambda[j] + alpha * dl < 0.0 {
-                alpha = -self.lambda[j] / dl;
+        }
+        // Slices of one length, bound once: no bounds checks or field reloads in the loop.
+        let rows = &qp.inequalities[..];
+        let n = rows.len();
+        let Self {
+            dz,
+            d_sigma,
+            r_in,
+            rc,
+            lambda,
+            inv_s,
+            s,
+            ds,
+            d_lambda,
+            ..
+        } = self;
+        let (r_in, rc, lambda, inv_s, s) =
+            (&r_in[..n], &rc[..n], &lambda[..n], &inv_s[..n], &s[..n]);
+        let (ds, d_lambda) = (&mut ds[..n], &mut d_lambda[..n]);
+        let mut alpha = 1.0_f64;
+        for j in 0..n {
+            let row = &rows[j];
+            let gz = row.core.map_or(0.0, |(i, l)| row.coef * dz[i][l])
+                + row.slack.map_or(0.0, |k| row.slack_coef * d_sigma[k]);
+            let step_s = -r_in[j] - gz;
+            let step_l = -(rc[j] + lambda[j] * step_s) * inv_s[j];
+            ds[j] = step_s;
+            d_lambda[j] = step_l;
+            // Divide only where the bound tightens (rare once α has settled).
+            if s[j] + alpha * step_s < 0.0 {
+                alpha = -s[j] / step_s;
+            }
+            if lambda[j] + alpha * step_l < 0.0 {
+                alpha = -lambda[j] / step_l;
             }
         }
         alpha
@@ -659,23 +735,37 @@ impl Ipm {
         }
         self.r_dual_sigma.fill(0.0);
         let (mut hl, mut norm_s, mut norm_lambda, mut norm_r_in) = (0.0, 0.0_f64, 0.0_f64, 0.0_f64);
-        for (j, row) in qp.inequalities.iter().enumerate() {
-            let (l, s) = (self.lambda[j], self.s[j]);
-            let mut gz = 0.0;
-            if let Some((i, c)) = row.core {
-                self.r_dual[i][c] += row.coef * l;
-                gz += row.coef * self.z[i][c];
+        {
+            let Self {
+                lambda,
+                s,
+                r_dual,
+                r_dual_sigma,
+                z,
+                sigma,
+                r_in,
+                ..
+            } = self;
+            let n = qp.inequalities.len();
+            let (lambda, s, r_in) = (&lambda[..n], &s[..n], &mut r_in[..n]);
+            for (j, row) in qp.inequalities.iter().enumerate() {
+                let (l, s) = (lambda[j], s[j]);
+                let mut gz = 0.0;
+                if let Some((i, c)) = row.core {
+                    r_dual[i][c] += row.coef * l;
+                    gz += row.coef * z[i][c];
+                }
+                if let Some(n) = row.slack {
+                    r_dual_sigma[n] += row.slack_coef * l;
+                    gz += row.slack_coef * sigma[n];
+                }
+                let r = gz + s - row.h;
+                r_in[j] = r;
+                hl += row.h * l;
+                norm_s = norm_s.max(s.abs());
+                norm_lambda = norm_lambda.max(l.abs());
+                norm_r_in = norm_r_in.max(r.abs());
             }
-            if let Some(n) = row.slack {
-                self.r_dual_sigma[n] += row.slack_coef * l;
-                gz += row.slack_coef * self.sigma[n];
-            }
-            let r = gz + s - row.h;
-            self.r_in[j] = r;
-            hl += row.h * l;
-            norm_s = norm_s.max(s.abs());
-            norm_lambda = norm_lambda.max(l.abs());
-            norm_r_in = norm_r_in.max(r.abs());
         }
         // Pass over the slacks.
         let (mut qx, mut certificate_residual, mut dual, mut norm_z) =
