@@ -177,6 +177,30 @@ impl Ipm {
     /// Sizes every buffer for `qp` (the only allocation of a solve).
     pub fn resize(&mut self, qp: &StageQp) {
         let (k, n_slack, m_in) = (qp.k, qp.slack_cost.len(), qp.inequalities.len());
+        let sized = self.z.len() == k + 1
+            && self.y_dynamics.len() == k
+            && self.sigma.len() == n_slack
+            && self.s.len() == m_in;
+        if sized {
+            // Same sizes as the last plan: every buffer is overwritten before it is
+            // read, except the iterate, which starts at zero.
+            self.z.fill(Vector6::zeros());
+            self.y_dynamics.fill(Vector4::zeros());
+            self.sigma.fill(0.0);
+            self.s.fill(0.0);
+            self.lambda.fill(0.0);
+        } else {
+            self.allocate(k, n_slack, m_in);
+        }
+        self.y_initial = Vector4::zeros();
+        self.y_terminal = Vector4::zeros();
+        self.iterations = 0;
+        self.best = None;
+        self.set_norms(qp);
+    }
+
+    /// Sizes and zeroes every buffer.
+    fn allocate(&mut self, k: usize, n_slack: usize, m_in: usize) {
         for v in [
             &mut self.z,
             &mut self.grad,
@@ -243,6 +267,10 @@ impl Ipm {
         self.y_initial = Vector4::zeros();
         self.y_terminal = Vector4::zeros();
         self.iterations = 0;
+    }
+
+    /// The norms of the data used by the stopping rule.
+    fn set_norms(&mut self, qp: &StageQp) {
         let m = qp.terminal_rows;
         self.norm_b = norm_inf(qp.x0.iter())
             .max(qp.dynamics.iter().fold(0.0, |n, d| n.max(d.c.amax())))

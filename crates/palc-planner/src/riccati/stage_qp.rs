@@ -73,6 +73,8 @@ pub(crate) struct StageQp {
     pub inequalities: Vec<Inequality>,
     /// Equality rows `m_eq = 4 + 4K + m`.
     pub m_eq: usize,
+    /// Per stage variable (`NZ * stage + local`): whether a slack is tied to it.
+    softly_bounded: Vec<bool>,
     /// The constant of the objective (squared-distance and tracking constants).
     pub constant: f64,
 }
@@ -241,9 +243,14 @@ impl StageQp {
         if let Some(j) = self.slack_rows.iter().position(|r| r[0] == usize::MAX) {
             return Err(format!("slack {j} has no inequality row"));
         }
+        self.softly_bounded.clear();
+        self.softly_bounded.resize(NZ * (k + 1), false);
+        for &(i, l) in self.slack_core.iter().flatten() {
+            self.softly_bounded[NZ * i + l] = true;
+        }
         for (row, ineq) in self.inequalities.iter().enumerate() {
-            if let (Some(core), None) = (ineq.core, ineq.slack) {
-                if self.slack_core.contains(&Some(core)) {
+            if let (Some((i, l)), None) = (ineq.core, ineq.slack) {
+                if self.softly_bounded[NZ * i + l] {
                     return Err(format!(
                         "row {row} bounds a softly bounded variable without its slack"
                     ));
