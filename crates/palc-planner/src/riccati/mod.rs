@@ -5,8 +5,9 @@
 //! - [`stage_qp`]: reads the assembled [`QpData`] back into stage form;
 //! - [`recursion`]: the Riccati factorization and solve, terminal rows by a Schur
 //!   complement on their multiplier;
-//! - [`ipm`]: the interior point (start, predictor, corrector, stopping rule,
-//!   infeasibility certificate).
+//! - [`sparse`]: products with `A_i`, `B_i` in the kinematic bicycle's pattern;
+//! - [`ipm`]: the interior point (start, predictor, corrector, refinement, stopping
+//!   rule, infeasibility certificate).
 //!
 //! Every buffer is sized once per plan; nothing is allocated inside the iterations.
 
