@@ -44,7 +44,8 @@ pub enum Backend {
 }
 
 /// Settings passed to the QP solver; the defaults were chosen by measurement
-/// (see the crate documentation and docs/paper-mapping.md).
+/// (see the crate documentation and docs/paper-mapping.md). Both backends read
+/// `max_iter` and the three tolerances; the last three fields are clarabel's.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SolverSettings {

@@ -52,7 +52,9 @@ pub struct SolveStats {
     pub build_seconds: f64,
     /// Wall time of the solve itself (s).
     pub solve_seconds: f64,
-    /// Whether the cached solver structure was reused (values overwritten only).
+    /// Whether the previous plan had the same sparsity pattern, so that the cached
+    /// structure was reused: clarabel's solver (values overwritten only) or the
+    /// Riccati backend's buffers.
     pub structure_reused: bool,
 }
 
