@@ -307,3 +307,59 @@ fn both_backends_refuse_invalid_input_alike() {
         assert_eq!(a.to_string(), b.to_string());
     }
 }
+
+#[test]
+fn both_backends_agree_without_an_acceleration_penalty() {
+    // With `ρ_a = 0` the acceleration's only curvature comes through `s` (w9 + w10):
+    // the Riccati backend's control block then rests on its static regularization.
+    for speed in [12.0, 20.0, 28.0] {
+        let config = PlannerConfig {
+            horizon: 50,
+            acceleration_penalty: 0.0,
+            ..PlannerConfig::default()
+        };
+        let problem = lane_change(&config, speed);
+        let riccati = plan_with(Backend::Riccati, &config, &problem).unwrap();
+        let clarabel = plan_with(Backend::Clarabel, &reference_config(&config), &problem).unwrap();
+        let scale = 1.0 + clarabel.objective.abs();
+        assert!(
+            (riccati.objective - clarabel.objective).abs() <= 1e-6 * scale,
+            "speed {speed}: riccati {} vs clarabel {}",
+            riccati.objective,
+            clarabel.objective
+        );
+    }
+}
+
+#[test]
+fn both_backends_agree_on_the_shortest_horizons() {
+    // K = 1..4: l_1 = l_0 is fixed by X_0, so a lane change needs K >= 3 steps and
+    // enough steering; staying in the lane is always feasible.
+    for k in 1..=4 {
+        for target in [0.0, 3.5] {
+            let config = PlannerConfig {
+                horizon: k,
+                dt: 0.5,
+                ..PlannerConfig::default()
+            };
+            let mut problem = lane_change(&config, 20.0);
+            problem.terminal.l = target;
+            let riccati = plan_with(Backend::Riccati, &config, &problem);
+            let clarabel = plan_with(Backend::Clarabel, &reference_config(&config), &problem);
+            match (&riccati, &clarabel) {
+                (Ok(r), Ok(c)) => assert!(
+                    (r.objective - c.objective).abs() <= 1e-6 * (1.0 + c.objective.abs()),
+                    "K = {k}, l_K = {target}: riccati {} vs clarabel {}",
+                    r.objective,
+                    c.objective
+                ),
+                (Err(PlanError::Infeasible { .. }), Err(PlanError::Infeasible { .. })) => {
+                    assert!(target != 0.0, "K = {k}: staying in the lane refused");
+                }
+                _ => {
+                    panic!("K = {k}, l_K = {target}: riccati {riccati:?} vs clarabel {clarabel:?}")
+                }
+            }
+        }
+    }
+}
