@@ -20,12 +20,10 @@ pub(crate) const NX: usize = 4;
 /// Variables per stage (state and control).
 pub(crate) const NZ: usize = 6;
 
-/// `X_{i+1} = a X_i + b U_i + c` (Eqs. 11-14); `sparse` holds `a` and `b` by their
-/// non-zero entries for the products of the recursion.
+/// `X_{i+1} = A X_i + B U_i + c` (Eqs. 11-14); `sparse` holds `A` and `B` in the
+/// cheapest exact form for the products of the recursion.
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct Dynamics {
-    pub a: Matrix4<f64>,
-    pub b: Matrix4x2<f64>,
     pub c: Vector4<f64>,
     pub sparse: StepDynamics,
 }
@@ -54,6 +52,8 @@ pub(crate) struct StageQp {
     pub linear: Vec<Vector6<f64>>,
     /// Dynamics of steps `0..K`.
     pub dynamics: Vec<Dynamics>,
+    /// `(A_i, B_i)` accumulated from the triplets while loading.
+    dense_dynamics: Vec<(Matrix4<f64>, Matrix4x2<f64>)>,
     /// The fixed initial state.
     pub x0: Vector4<f64>,
     /// Number of terminal rows `m <= 4`.
@@ -111,6 +111,9 @@ impl StageQp {
         self.linear.resize(k + 1, Vector6::zeros());
         self.dynamics.clear();
         self.dynamics.resize(k, Dynamics::default());
+        self.dense_dynamics.clear();
+        self.dense_dynamics
+            .resize(k, (Matrix4::zeros(), Matrix4x2::zeros()));
         self.slack_cost.clear();
         self.slack_cost.extend_from_slice(&data.q[n_core..]);
         self.slack_core.clear();
@@ -157,9 +160,9 @@ impl StageQp {
                         return Err(format!("dynamics row {r} is not X_(i+1)[{comp}] = ..."));
                     }
                 } else if stage == step && local < NX {
-                    self.dynamics[step].a[(comp, local)] -= v;
+                    self.dense_dynamics[step].0[(comp, local)] -= v;
                 } else if stage == step {
-                    self.dynamics[step].b[(comp, local - NX)] -= v;
+                    self.dense_dynamics[step].1[(comp, local - NX)] -= v;
                 } else {
                     return Err(format!("dynamics row {r} reaches stage {stage}"));
                 }
@@ -178,7 +181,8 @@ impl StageQp {
             for comp in 0..NX {
                 d.c[comp] = data.b[NX + NX * step + comp];
             }
-            d.sparse = StepDynamics::new(&d.a, &d.b);
+            let (a, b) = &self.dense_dynamics[step];
+            d.sparse = StepDynamics::new(a, b);
         }
         for j in 0..self.terminal_rows {
             self.terminal_rhs[j] = data.b[first_terminal + j];
