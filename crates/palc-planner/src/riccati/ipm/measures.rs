@@ -4,6 +4,7 @@
 use nalgebra::Vector6;
 
 use super::super::stage_qp::{NX, StageQp};
+use super::newton::row_times;
 use super::{Ipm, Tolerances, head};
 
 /// Convergence measures of one iterate.
@@ -69,15 +70,13 @@ impl Ipm {
             let (lambda, s, r_in) = (&lambda[..n], &s[..n], &mut r_in[..n]);
             for (j, row) in qp.inequalities.iter().enumerate() {
                 let (l, s) = (lambda[j], s[j]);
-                let mut gz = 0.0;
                 if let Some((i, c)) = row.core {
                     r_dual[i][c] += row.coef * l;
-                    gz += row.coef * z[i][c];
                 }
                 if let Some(n) = row.slack {
                     r_dual_sigma[n] += row.slack_coef * l;
-                    gz += row.slack_coef * sigma[n];
                 }
+                let gz = row_times(row, z, sigma);
                 let r = gz + s - row.h;
                 r_in[j] = r;
                 hl += row.h * l;

@@ -127,6 +127,7 @@ pub(crate) struct Ipm {
     // Iterative refinement: the residual of the stationarity rows and the correction.
     e: Vec<Vector6<f64>>,
     e_sigma: Vec<f64>,
+    d_sigma_c: Vec<f64>,
     zero_offsets: Vec<Vector4<f64>>,
     dz_c: Vec<Vector6<f64>>,
     y_dynamics_c: Vec<Vector4<f64>>,
@@ -198,6 +199,7 @@ impl Ipm {
             &mut self.g_sigma,
             &mut self.d_sigma,
             &mut self.e_sigma,
+            &mut self.d_sigma_c,
         ] {
             v.clear();
             v.resize(n_slack, 0.0);

@@ -5,8 +5,77 @@
 use nalgebra::{Vector4, Vector6};
 
 use super::super::recursion::{FactorError, Rhs, Step};
-use super::super::stage_qp::StageQp;
+use super::super::stage_qp::{Inequality, StageQp};
 use super::{Ipm, head};
+
+/// `(G z)_j`: row `j` of the inequalities applied to stage variables `z` and slacks `σ`.
+#[inline(always)]
+pub(super) fn row_times(row: &Inequality, z: &[Vector6<f64>], sigma: &[f64]) -> f64 {
+    row.core.map_or(0.0, |(i, l)| row.coef * z[i][l])
+        + row.slack.map_or(0.0, |k| row.slack_coef * sigma[k])
+}
+
+/// `Δλ_j = -(r_c + λ Δs) / s` of one row, and the step bound `α` tightened so that
+/// `s + α Δs >= 0` and `λ + α Δλ >= 0` (a division only where the bound tightens,
+/// rare once `α` has settled).
+#[inline(always)]
+fn dual_step(s: f64, lambda: f64, rc: f64, inv_s: f64, ds: f64, alpha: &mut f64) -> f64 {
+    let dl = -(rc + lambda * ds) * inv_s;
+    if s + *alpha * ds < 0.0 {
+        *alpha = -s / ds;
+    }
+    if lambda + *alpha * dl < 0.0 {
+        *alpha = -lambda / dl;
+    }
+    dl
+}
+
+/// `out += Gᵀ v`, split into stage variables and slacks.
+fn add_g_transpose(qp: &StageQp, v: &[f64], out: &mut [Vector6<f64>], out_sigma: &mut [f64]) {
+    for (row, &v) in qp.inequalities.iter().zip(v) {
+        if let Some((i, l)) = row.core {
+            out[i][l] += row.coef * v;
+        }
+        if let Some(j) = row.slack {
+            out_sigma[j] += row.slack_coef * v;
+        }
+    }
+}
+
+/// Eliminates each slack from a right-hand side: `g_l -= h_σl g_σ / h_σσ`.
+fn eliminate_slacks(
+    qp: &StageQp,
+    h_sv: &[f64],
+    inv_h_ss: &[f64],
+    g: &mut [Vector6<f64>],
+    g_sigma: &[f64],
+) {
+    let n = qp.slack_core.len();
+    let (g_sigma, h_sv, inv_h_ss) = (&g_sigma[..n], &h_sv[..n], &inv_h_ss[..n]);
+    for (j, core) in qp.slack_core.iter().enumerate() {
+        if let Some((i, l)) = *core {
+            g[i][l] -= h_sv[j] * g_sigma[j] * inv_h_ss[j];
+        }
+    }
+}
+
+/// Recovers each slack's step from its variable's: `Δσ = -(g_σ + h_σl Δl) / h_σσ`.
+fn recover_slacks(
+    qp: &StageQp,
+    h_sv: &[f64],
+    inv_h_ss: &[f64],
+    dz: &[Vector6<f64>],
+    g_sigma: &[f64],
+    d_sigma: &mut [f64],
+) {
+    let n = qp.slack_core.len();
+    let (d_sigma, g_sigma, h_sv, inv_h_ss) =
+        (&mut d_sigma[..n], &g_sigma[..n], &h_sv[..n], &inv_h_ss[..n]);
+    for (j, core) in qp.slack_core.iter().enumerate() {
+        let coupled = core.map_or(0.0, |(i, l)| h_sv[j] * dz[i][l]);
+        d_sigma[j] = -(g_sigma[j] + coupled) * inv_h_ss[j];
+    }
+}
 
 impl Ipm {
     /// `Δλ = -r_c / s - W Δs`, and the largest `α <= 1` with `s + α Δs >= 0` and
@@ -14,15 +83,8 @@ impl Ipm {
     pub(super) fn dual_step_to_boundary(&mut self) -> f64 {
         let mut alpha = 1.0_f64;
         for j in 0..self.s.len() {
-            let ds = self.ds[j];
-            let dl = -(self.rc[j] + self.lambda[j] * ds) * self.inv_s[j];
-            self.d_lambda[j] = dl;
-            if self.s[j] + alpha * ds < 0.0 {
-                alpha = -self.s[j] / ds;
-            }
-            if self.lambda[j] + alpha * dl < 0.0 {
-                alpha = -self.lambda[j] / dl;
-            }
+            let (s, l, rc, inv_s) = (self.s[j], self.lambda[j], self.rc[j], self.inv_s[j]);
+            self.d_lambda[j] = dual_step(s, l, rc, inv_s, self.ds[j], &mut alpha);
         }
         alpha
     }
@@ -48,19 +110,8 @@ impl Ipm {
         }
         let dnu = self.y_terminal_new - self.y_terminal;
         head(&mut self.e[k], &qp.terminal.tr_mul(&dnu));
-        for (row, &dl) in qp.inequalities.iter().zip(&self.d_lambda) {
-            if let Some((i, l)) = row.core {
-                self.e[i][l] += row.coef * dl;
-            }
-            if let Some(j) = row.slack {
-                self.e_sigma[j] += row.slack_coef * dl;
-            }
-        }
-        for (j, core) in qp.slack_core.iter().enumerate() {
-            if let Some((i, l)) = *core {
-                self.e[i][l] -= self.h_sv[j] * self.e_sigma[j] * self.inv_h_ss[j];
-            }
-        }
+        add_g_transpose(qp, &self.d_lambda, &mut self.e, &mut self.e_sigma);
+        eliminate_slacks(qp, &self.h_sv, &self.inv_h_ss, &mut self.e, &self.e_sigma);
         let rhs = Rhs {
             linear: &self.e,
             offsets: &self.zero_offsets,
@@ -78,6 +129,14 @@ impl Ipm {
                 y_terminal: &mut dnu,
             },
         );
+        recover_slacks(
+            qp,
+            &self.h_sv,
+            &self.inv_h_ss,
+            &self.dz_c,
+            &self.e_sigma,
+            &mut self.d_sigma_c,
+        );
         for i in 0..=k {
             self.dz[i] += self.dz_c[i];
         }
@@ -86,17 +145,11 @@ impl Ipm {
         }
         self.y_initial_new += dy0;
         self.y_terminal_new += dnu;
-        for (j, core) in qp.slack_core.iter().enumerate() {
-            let coupled = core.map_or(0.0, |(i, l)| self.h_sv[j] * self.dz_c[i][l]);
-            let correction = -(self.e_sigma[j] + coupled) * self.inv_h_ss[j];
-            self.d_sigma[j] += correction;
-            // Reuse e_sigma for the slack's correction (read by the rows below).
-            self.e_sigma[j] = correction;
+        for (d_sigma, correction) in self.d_sigma.iter_mut().zip(&self.d_sigma_c) {
+            *d_sigma += correction;
         }
-        for (j, row) in qp.inequalities.iter().enumerate() {
-            let gz = row.core.map_or(0.0, |(i, l)| row.coef * self.dz_c[i][l])
-                + row.slack.map_or(0.0, |m| row.slack_coef * self.e_sigma[m]);
-            self.ds[j] -= gz;
+        for (ds, row) in self.ds.iter_mut().zip(&qp.inequalities) {
+            *ds -= row_times(row, &self.dz_c, &self.d_sigma_c);
         }
     }
 
@@ -152,31 +205,8 @@ impl Ipm {
     pub(super) fn newton_step(&mut self, qp: &StageQp) -> f64 {
         self.g.copy_from_slice(&self.grad);
         self.g_sigma.copy_from_slice(&qp.slack_cost);
-        {
-            let Self {
-                g,
-                g_sigma,
-                xi,
-                h_sv,
-                inv_h_ss,
-                ..
-            } = self;
-            for (row, &xi) in qp.inequalities.iter().zip(xi.iter()) {
-                if let Some((i, l)) = row.core {
-                    g[i][l] += row.coef * xi;
-                }
-                if let Some(j) = row.slack {
-                    g_sigma[j] += row.slack_coef * xi;
-                }
-            }
-            let n = qp.slack_core.len();
-            let (g_sigma, h_sv, inv_h_ss) = (&g_sigma[..n], &h_sv[..n], &inv_h_ss[..n]);
-            for (j, core) in qp.slack_core.iter().enumerate() {
-                if let Some((i, l)) = *core {
-                    g[i][l] -= h_sv[j] * g_sigma[j] * inv_h_ss[j];
-                }
-            }
-        }
+        add_g_transpose(qp, &self.xi, &mut self.g, &mut self.g_sigma);
+        eliminate_slacks(qp, &self.h_sv, &self.inv_h_ss, &mut self.g, &self.g_sigma);
         let rhs = Rhs {
             linear: &self.g,
             offsets: &self.offsets,
@@ -193,23 +223,14 @@ impl Ipm {
                 y_terminal: &mut self.y_terminal_new,
             },
         );
-        {
-            let Self {
-                dz,
-                d_sigma,
-                g_sigma,
-                h_sv,
-                inv_h_ss,
-                ..
-            } = self;
-            let n = qp.slack_core.len();
-            let (d_sigma, g_sigma, h_sv, inv_h_ss) =
-                (&mut d_sigma[..n], &g_sigma[..n], &h_sv[..n], &inv_h_ss[..n]);
-            for (j, core) in qp.slack_core.iter().enumerate() {
-                let coupled = core.map_or(0.0, |(i, l)| h_sv[j] * dz[i][l]);
-                d_sigma[j] = -(g_sigma[j] + coupled) * inv_h_ss[j];
-            }
-        }
+        recover_slacks(
+            qp,
+            &self.h_sv,
+            &self.inv_h_ss,
+            &self.dz,
+            &self.g_sigma,
+            &mut self.d_sigma,
+        );
         // Slices of one length, bound once: no bounds checks or field reloads in the loop.
         let rows = &qp.inequalities[..];
         let n = rows.len();
@@ -230,20 +251,9 @@ impl Ipm {
         let (ds, d_lambda) = (&mut ds[..n], &mut d_lambda[..n]);
         let mut alpha = 1.0_f64;
         for j in 0..n {
-            let row = &rows[j];
-            let gz = row.core.map_or(0.0, |(i, l)| row.coef * dz[i][l])
-                + row.slack.map_or(0.0, |k| row.slack_coef * d_sigma[k]);
-            let step_s = -r_in[j] - gz;
-            let step_l = -(rc[j] + lambda[j] * step_s) * inv_s[j];
+            let step_s = -r_in[j] - row_times(&rows[j], dz, d_sigma);
             ds[j] = step_s;
-            d_lambda[j] = step_l;
-            // Divide only where the bound tightens (rare once α has settled).
-            if s[j] + alpha * step_s < 0.0 {
-                alpha = -s[j] / step_s;
-            }
-            if lambda[j] + alpha * step_l < 0.0 {
-                alpha = -lambda[j] / step_l;
-            }
+            d_lambda[j] = dual_step(s[j], lambda[j], rc[j], inv_s[j], step_s, &mut alpha);
         }
         alpha
     }
