@@ -1,25 +1,32 @@
 //! Project tasks for palc, run as `cargo xtask <task>` from anywhere in the
 //! workspace (the alias lives in `.cargo/config.toml`).
 //!
-//! `reproduce-paper` regenerates the paper's evaluation (`reproduce/`).
+//! xtask only orchestrates: `reproduce-paper` runs the product's own command,
+//! `palc eval`, in a release build, so the evaluation lives in one place
+//! (`crates/palc-eval`) and the task and the command give the same outputs.
 //! Repository hygiene lives in `tidy.rs` as ordinary tests, run by
 //! `cargo test --workspace`.
 
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
-mod reproduce;
+use anyhow::Context;
+
 #[cfg(test)]
 mod tidy;
 
 fn main() -> anyhow::Result<()> {
-    std::env::set_current_dir(project_root())?;
-    let task = std::env::args().nth(1);
+    let root = project_root();
+    std::env::set_current_dir(&root)
+        .with_context(|| format!("cannot enter the workspace root {}", root.display()))?;
+    let mut args = std::env::args().skip(1);
+    let task = args.next();
     match task.as_deref() {
         None | Some("help" | "--help" | "-h") => {
             print_help();
             Ok(())
         }
-        Some("reproduce-paper") => reproduce::main(std::env::args().skip(2)),
+        Some("reproduce-paper") => reproduce_paper(args),
         Some(other) => {
             print_help();
             anyhow::bail!("unknown task `{other}`")
@@ -30,15 +37,36 @@ fn main() -> anyhow::Result<()> {
 fn print_help() {
     println!(
         "cargo xtask <task>\n\ntasks:\n  \
-         reproduce-paper  regenerate the paper's evaluation (--quick, --jobs N, --out DIR)\n  \
+         reproduce-paper  regenerate the paper's evaluation (--quick, --jobs N, --out DIR, --config FILE);\n                   \
+         the same as `palc eval` in a release build\n  \
          help             this text"
     );
 }
 
+/// `cargo xtask reproduce-paper [flags]`: `palc eval [flags]`, built in release mode.
+fn reproduce_paper(args: impl Iterator<Item = String>) -> anyhow::Result<()> {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let status = Command::new(cargo)
+        .args([
+            "run",
+            "--release",
+            "--quiet",
+            "--package",
+            "palc-cli",
+            "--bin",
+            "palc",
+            "--",
+        ])
+        .arg("eval")
+        .args(args)
+        .status()
+        .context("cannot run cargo")?;
+    anyhow::ensure!(status.success(), "`palc eval` failed ({status})");
+    Ok(())
+}
+
 /// The workspace root: the parent of this crate's manifest directory.
 fn project_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-        .parent()
-        .expect("xtask lives one level below the workspace root")
-        .to_path_buf()
+    let manifest_dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    manifest_dir.parent().unwrap_or(manifest_dir).to_path_buf()
 }

@@ -125,3 +125,68 @@ fn no_stubs_are_left_in_the_code() {
         .collect();
     assert!(offenders.is_empty(), "stubs left in {offenders:?}");
 }
+
+/// xtask only orchestrates; the evaluation lives in `crates/palc-eval`.
+const XTASK_LINE_BUDGET: usize = 400;
+
+#[test]
+fn xtask_stays_within_its_line_budget() {
+    let mut files = Vec::new();
+    rust_files(&project_root().join("xtask/src"), &mut files);
+    let lines: usize = files.iter().map(|path| read(path).lines().count()).sum();
+    assert!(
+        lines < XTASK_LINE_BUDGET,
+        "xtask/src has {lines} lines, over its budget of {XTASK_LINE_BUDGET}: \
+         move computation into a product crate (the evaluation lives in crates/palc-eval)"
+    );
+}
+
+/// The `[dependencies]` (not dev-dependencies) of a crate's manifest, by name.
+fn dependencies(manifest: &Path) -> Vec<String> {
+    let text = read(manifest);
+    let mut in_section = false;
+    let mut names = Vec::new();
+    for line in text.lines() {
+        let line = line.trim();
+        if line.starts_with('[') {
+            in_section = line == "[dependencies]";
+            continue;
+        }
+        if in_section && !line.is_empty() && !line.starts_with('#') {
+            if let Some((name, _)) = line.split_once(['=', '.']) {
+                names.push(name.trim().to_owned());
+            }
+        }
+    }
+    names
+}
+
+#[test]
+fn only_binaries_depend_on_the_evaluation() {
+    let offenders: Vec<String> = crate_dirs()
+        .iter()
+        .filter(|dir| !dir.ends_with("palc-cli") && !dir.ends_with("palc-eval"))
+        .filter(|dir| {
+            dependencies(&dir.join("Cargo.toml"))
+                .iter()
+                .any(|d| d == "palc-eval")
+        })
+        .map(|dir| dir.display().to_string())
+        .collect();
+    assert!(
+        offenders.is_empty(),
+        "library crates that depend on palc-eval (only palc-cli may): {offenders:?}"
+    );
+}
+
+#[test]
+fn the_zone_filter_and_the_planner_depend_on_no_other_palc_crate() {
+    for name in ["palc-zone-filter", "palc-planner"] {
+        let manifest = project_root().join("crates").join(name).join("Cargo.toml");
+        let palc: Vec<String> = dependencies(&manifest)
+            .into_iter()
+            .filter(|d| d.starts_with("palc-"))
+            .collect();
+        assert!(palc.is_empty(), "{name} depends on {palc:?}");
+    }
+}

@@ -17,6 +17,9 @@ struct Cli {
 
 #[derive(Debug, Subcommand)]
 enum Command {
+    /// Run an evaluation config: the paper's reproduction by default (runs, statistics,
+    /// REPORT.md, figures).
+    Eval(commands::eval::EvalArgs),
     /// Learn a user's lane changes from takeovers (the lesson-learning loop).
     Learn(commands::learn::LearnArgs),
     /// Background traffic on its own (IDM scenes, platoons).
@@ -30,6 +33,7 @@ enum Command {
 fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.command {
+        Command::Eval(args) => commands::eval::run(args),
         Command::Learn(args) => commands::learn::run_learn(args),
         Command::Traffic(args) => commands::traffic::run(args),
         Command::Plan(args) => commands::plan::run(args),

@@ -1,5 +1,6 @@
 //! One module per `palc` subcommand.
 
+pub mod eval;
 pub mod learn;
 pub mod plan;
 pub mod traffic;

@@ -3,10 +3,10 @@
 
 use std::path::Path;
 
-use anyhow::Context;
 use serde::{Deserialize, Serialize};
 
-use super::plan::RunSpec;
+use crate::EvalError;
+use crate::plan::RunSpec;
 
 /// How a run ended, as the report counts it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -57,6 +57,9 @@ pub struct Iteration {
     pub max_deviation_m: f64,
     /// Compute time by part: zone fit, bounds, expert, correction, plan (s).
     pub times_s: [f64; 5],
+    /// Why the lesson of this lane change could not be learned, if it could not.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub learning_error: Option<String>,
 }
 
 /// Names of the parts of [`Iteration::times_s`].
@@ -142,7 +145,6 @@ impl RunRow {
 
     /// This row with every measured time set to zero: what must not depend on
     /// the machine or the number of threads.
-    #[cfg(test)]
     pub fn without_timing(&self) -> RunRow {
         let mut row = self.clone();
         row.wall_s = 0.0;
@@ -180,11 +182,14 @@ struct CsvRow<'a> {
 }
 
 /// Writes `runs.json` (every field) and `runs.csv` (one line per run).
-pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> anyhow::Result<()> {
-    let text = serde_json::to_string_pretty(rows).context("cannot serialize the runs")?;
-    std::fs::write(json, text).with_context(|| format!("cannot write {}", json.display()))?;
-    let mut writer = csv::Writer::from_path(csv_path)
-        .with_context(|| format!("cannot write {}", csv_path.display()))?;
+pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> Result<(), EvalError> {
+    let text = serde_json::to_string_pretty(rows)?;
+    std::fs::write(json, text).map_err(|source| EvalError::Io {
+        action: "write",
+        path: json.to_owned(),
+        source,
+    })?;
+    let mut writer = csv::Writer::from_path(csv_path)?;
     for row in rows {
         let note = match &row.status {
             Status::Refused { reason } => reason.clone(),
@@ -194,7 +199,7 @@ pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> anyhow::Result<()
         writer.serialize(CsvRow {
             id: row.spec.id,
             experiment: row.spec.experiment.name(),
-            method: &row.spec.method,
+            method: row.spec.method.name(),
             user: &row.spec.user.name,
             style: &row.spec.style,
             speed_case: &row.spec.speed_case.name,
@@ -215,21 +220,23 @@ pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> anyhow::Result<()
             note,
         })?;
     }
-    writer
-        .flush()
-        .with_context(|| format!("cannot write {}", csv_path.display()))?;
+    writer.flush().map_err(|source| EvalError::Io {
+        action: "write",
+        path: csv_path.to_owned(),
+        source,
+    })?;
     Ok(())
 }
 
 #[cfg(test)]
 mod tests {
-    use super::super::runner::tests::synthetic_rows;
     use super::*;
+    use crate::runner::tests::synthetic_rows;
 
     #[test]
     fn csv_has_one_line_per_run_and_json_reads_back() {
         let rows = synthetic_rows();
-        let dir = std::env::temp_dir().join(format!("palc-xtask-results-{}", std::process::id()));
+        let dir = std::env::temp_dir().join(format!("palc-eval-results-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let (json, csv_path) = (dir.join("runs.json"), dir.join("runs.csv"));
         write(&rows, &json, &csv_path).unwrap();

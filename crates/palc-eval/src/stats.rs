@@ -6,8 +6,8 @@ use std::collections::HashMap;
 
 use serde::Serialize;
 
-use super::plan::{CellKey, Experiment};
-use super::results::{Iteration, PART_NAMES, RunRow};
+use crate::plan::{CellKey, Experiment};
+use crate::results::{Iteration, PART_NAMES, RunRow};
 
 /// Takeover statistics of a set of runs; refused runs are counted apart.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -270,11 +270,88 @@ impl Trend {
     }
 }
 
+/// Mean takeovers of the rows for which `keep` holds.
+fn mean_where(rows: &[&RunRow], keep: impl Fn(&RunRow) -> bool) -> Option<f64> {
+    Summary::of(rows.iter().copied().filter(|r| keep(r))).mean
+}
+
+/// The paper's style trend: aggressive users need fewer takeovers than cautious ones.
+pub fn style_trend(rows: &[&RunRow]) -> Trend {
+    Trend {
+        first: (
+            "aggressive".into(),
+            mean_where(rows, |r| r.spec.style == "aggressive"),
+        ),
+        second: (
+            "cautious".into(),
+            mean_where(rows, |r| r.spec.style == "cautious"),
+        ),
+    }
+}
+
+/// The paper's traffic-speed trend: for each ego speed, the case with the
+/// slower surrounding traffic needs fewer takeovers than the one with faster.
+/// A row is "slower" when another row has the same ego speed and faster others.
+pub fn traffic_speed_trend(rows: &[&RunRow]) -> Trend {
+    let has_other = |r: &RunRow, faster: bool| {
+        rows.iter().any(|o| {
+            let (mine, theirs) = (&r.spec.speed_case, &o.spec.speed_case);
+            mine.ego_mph == theirs.ego_mph
+                && if faster {
+                    theirs.others_mph > mine.others_mph
+                } else {
+                    theirs.others_mph < mine.others_mph
+                }
+        })
+    };
+    Trend {
+        first: ("slower".into(), mean_where(rows, |r| has_other(r, true))),
+        second: ("faster".into(), mean_where(rows, |r| has_other(r, false))),
+    }
+}
+
+/// The paper's congestion trend: the widest adjacent headway needs fewer
+/// takeovers than the narrowest.
+pub fn congestion_trend(rows: &[&RunRow]) -> Trend {
+    let headways = rows.iter().map(|r| r.spec.headway_m);
+    let widest = headways.clone().fold(f64::NEG_INFINITY, f64::max);
+    let narrowest = headways.fold(f64::INFINITY, f64::min);
+    Trend {
+        first: (
+            format!("{widest} m"),
+            mean_where(rows, |r| r.spec.headway_m == widest),
+        ),
+        second: (
+            format!("{narrowest} m"),
+            mean_where(rows, |r| r.spec.headway_m == narrowest),
+        ),
+    }
+}
+
+/// Users with spread: the mean final takeover rate of the counted runs and the
+/// mean ceiling (the rate of the user's own nominal plan on the same draws).
+pub fn final_rates(rows: &[&RunRow]) -> (Option<f64>, Option<f64>) {
+    let counted: Vec<&RunRow> = rows
+        .iter()
+        .copied()
+        .filter(|r| r.status.counted())
+        .collect();
+    let mean = |f: fn(&RunRow) -> Option<f64>| {
+        let v: Vec<f64> = counted.iter().filter_map(|r| f(r)).collect();
+        (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
+    };
+    (
+        mean(|r| r.final_takeover_rate),
+        mean(|r| r.ceiling_takeover_rate),
+    )
+}
+
 #[cfg(test)]
 mod tests {
-    use super::super::results::Status;
-    use super::super::runner::tests::synthetic_rows;
     use super::*;
+    use crate::results::Status;
+    use crate::runner::tests::synthetic_rows;
+    use palc_harness::Method;
 
     #[test]
     fn failures_count_at_the_cap_and_refusals_apart() {
@@ -309,7 +386,10 @@ mod tests {
     #[test]
     fn the_transfer_reduction_compares_the_same_cells() {
         let rows = synthetic_rows();
-        let refs: Vec<&RunRow> = rows.iter().filter(|r| r.spec.method == "palc").collect();
+        let refs: Vec<&RunRow> = rows
+            .iter()
+            .filter(|r| r.spec.method == Method::Palc)
+            .collect();
         let transfer = transfer(&refs);
         assert!(transfer.pairs > 0);
         // The synthetic executor needs three quarters of the takeovers (rounded down).
@@ -324,7 +404,10 @@ mod tests {
     #[test]
     fn safety_reaches_one_after_the_last_takeover() {
         let rows = synthetic_rows();
-        let refs: Vec<&RunRow> = rows.iter().filter(|r| r.spec.method == "palc").collect();
+        let refs: Vec<&RunRow> = rows
+            .iter()
+            .filter(|r| r.spec.method == Method::Palc)
+            .collect();
         let safety = safety(&refs);
         assert_eq!(safety.personalized_at_one, safety.personalized);
         assert!(safety.mean_by_iteration[0].0 < 1.0);

@@ -1,19 +1,18 @@
 //! Regression test on a small fixed subset of the reproduction, run through the
 //! real harness: the results are deterministic for a seed, do not depend on the
-//! number of threads, and their key statistics match `xtask/tests/golden/quick.json`.
+//! number of threads, and their key statistics match `tests/golden/quick.json`.
 //!
 //! When the model changes on purpose, rewrite the golden file with
-//! `PALC_UPDATE_GOLDEN=1 cargo test -p xtask golden` and give the reason in the
-//! commit message.
+//! `PALC_UPDATE_GOLDEN=1 cargo test -p palc-eval --test golden` and give the
+//! reason in the commit message.
 
+use std::path::{Path, PathBuf};
+
+use palc_eval::config::{Selection, TimingConfig, TransferConfig, TransferSource};
+use palc_eval::stats::Summary;
+use palc_eval::{Evaluation, Experiment, NoProgress, RunRow, plan, runner};
+use palc_harness::Method;
 use serde::{Deserialize, Serialize};
-
-use super::config::{ReproduceConfig, Selection, TimingConfig, TransferConfig, TransferSource};
-use super::harness_runs::HarnessRuns;
-use super::plan;
-use super::results::RunRow;
-use super::runner::{self, Progress};
-use super::stats::Summary;
 
 /// The key numbers of one run, rounded so that the file is readable.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -32,15 +31,23 @@ struct Golden {
     mean_takeovers_by_method: Vec<(String, Option<f64>)>,
 }
 
-fn golden_path() -> std::path::PathBuf {
-    crate::project_root().join("xtask/tests/golden/quick.json")
+fn project_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn golden_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden/quick.json")
 }
 
 /// Two speed cases, one headway, two styles, one seed, deterministic users,
 /// both methods, with the transfer experiment.
-fn subset(config: &ReproduceConfig) -> Selection {
-    let mut selection = config.select(true).expect("the quick subset is valid");
-    selection.grid.speed_cases = vec!["collector-high".into(), "collector-slow".into()];
+fn subset(evaluation: &Evaluation) -> Selection {
+    let mut selection = evaluation.selection().clone();
+    let testbed = evaluation.harness().testbed();
+    selection.grid.speed_cases = (testbed.speed_cases.iter())
+        .filter(|c| c.name == "collector-high" || c.name == "collector-slow")
+        .cloned()
+        .collect();
     selection.grid.headways_m = vec![40.0];
     selection.grid.styles = vec!["aggressive".into(), "cautious".into()];
     selection.grid.seeds = vec![1];
@@ -56,7 +63,7 @@ fn subset(config: &ReproduceConfig) -> Selection {
     selection
 }
 
-fn golden(rows: &[RunRow], methods: &[String]) -> Golden {
+fn golden(rows: &[RunRow], methods: &[Method]) -> Golden {
     Golden {
         runs: rows
             .iter()
@@ -75,11 +82,11 @@ fn golden(rows: &[RunRow], methods: &[String]) -> Golden {
             .collect(),
         mean_takeovers_by_method: methods
             .iter()
-            .map(|m| {
+            .map(|&m| {
                 let rows = rows
                     .iter()
-                    .filter(|r| &r.spec.method == m && r.spec.experiment == plan::Experiment::Grid);
-                (m.clone(), Summary::of(rows).mean)
+                    .filter(|r| r.spec.method == m && r.spec.experiment == Experiment::Grid);
+                (m.name().to_owned(), Summary::of(rows).mean)
             })
             .collect(),
     }
@@ -87,18 +94,15 @@ fn golden(rows: &[RunRow], methods: &[String]) -> Golden {
 
 #[test]
 fn the_quick_subset_is_deterministic_and_matches_the_golden_file() {
-    let root = crate::project_root();
-    let config_path = root.join("configs/reproduce.toml");
-    let text = std::fs::read_to_string(&config_path).unwrap();
-    let config = ReproduceConfig::from_toml_str(&text).unwrap();
-    let base = std::fs::read_to_string(config.base_path(&config_path)).unwrap();
-    let harness = HarnessRuns::from_toml_str(&base).unwrap();
-    let selection = subset(&config);
-    let plan = plan::expand(&selection, &harness.speed_cases().unwrap()).unwrap();
+    let config_path = project_root().join("configs/reproduce.toml");
+    let evaluation = Evaluation::load(&config_path, true).unwrap();
+    let harness = evaluation.harness();
+    let selection = subset(&evaluation);
+    let plan = plan::expand(&selection, harness.testbed()).unwrap();
     assert!(!plan.transfer.is_empty());
 
-    let one = runner::execute(&plan, &harness, 1, &Progress::new(plan.len(), true)).unwrap();
-    let two = runner::execute(&plan, &harness, 2, &Progress::new(plan.len(), true)).unwrap();
+    let one = runner::execute(&plan, harness, 1, &NoProgress).unwrap();
+    let two = runner::execute(&plan, harness, 2, &NoProgress).unwrap();
     let strip = |rows: &[RunRow]| rows.iter().map(RunRow::without_timing).collect::<Vec<_>>();
     assert_eq!(
         strip(&one),
@@ -116,7 +120,7 @@ fn the_quick_subset_is_deterministic_and_matches_the_golden_file() {
     }
     let stored: Golden = serde_json::from_str(&std::fs::read_to_string(&path).unwrap_or_else(|e| {
         panic!(
-            "cannot read {}: {e}; create it with `PALC_UPDATE_GOLDEN=1 cargo test -p xtask golden`",
+            "cannot read {}: {e}; create it with `PALC_UPDATE_GOLDEN=1 cargo test -p palc-eval --test golden`",
             path.display()
         )
     }))
@@ -125,7 +129,7 @@ fn the_quick_subset_is_deterministic_and_matches_the_golden_file() {
         measured,
         stored,
         "the quick subset's results changed; if the model changed on purpose, rewrite {} with \
-         `PALC_UPDATE_GOLDEN=1 cargo test -p xtask golden` and say why in the commit message",
+         `PALC_UPDATE_GOLDEN=1 cargo test -p palc-eval --test golden` and say why in the commit message",
         path.display()
     );
 }

@@ -4,51 +4,49 @@
 
 use std::time::Instant;
 
-use anyhow::Context;
 use palc_aggregator::Experience;
 use palc_harness::user::Spread;
 use palc_harness::{
-    CellChoice, HarnessError, LaneChangeRecord, LearnConfig, Method, NoObserver, Outcome,
-    RunResult, UserConfig,
+    CellChoice, HarnessError, LaneChangeRecord, LearnConfig, NoObserver, Outcome, RunResult,
+    UserConfig,
 };
+use palc_traffic::TestbedConfig;
 use serde::Serialize;
 
-use super::plan::{RunSpec, SpeedCase};
-use super::results::{Iteration, RunRow, Status};
-use super::runner::Executor;
+use crate::EvalError;
+use crate::plan::RunSpec;
+use crate::results::{Iteration, RunRow, Status};
+use crate::runner::Executor;
 
 /// Runs specs through `palc_harness::run`.
+#[derive(Debug)]
 pub struct HarnessRuns {
     base: LearnConfig,
+    testbed: TestbedConfig,
 }
 
 impl HarnessRuns {
-    /// Parses the base learning config.
-    pub fn from_toml_str(text: &str) -> anyhow::Result<HarnessRuns> {
-        let base = LearnConfig::from_toml_str(text).context("the base learning config")?;
-        Ok(HarnessRuns { base })
+    /// Runs made from `base`, which must have a `[traffic.testbed]`.
+    pub fn new(base: LearnConfig) -> Result<HarnessRuns, EvalError> {
+        let testbed = base.traffic.testbed.clone().ok_or_else(|| {
+            EvalError::invalid(
+                "traffic.testbed",
+                "missing",
+                "the test bed whose cells the evaluation runs",
+            )
+        })?;
+        Ok(HarnessRuns { base, testbed })
     }
 
-    /// The speed cases of the base config's test bed.
-    pub fn speed_cases(&self) -> anyhow::Result<Vec<SpeedCase>> {
-        let testbed = (self.base.traffic.testbed.as_ref())
-            .context("the base learning config has no `[traffic.testbed]`")?;
-        Ok(testbed
-            .speed_cases
-            .iter()
-            .map(|case| SpeedCase {
-                name: case.name.clone(),
-                ego_mph: case.ego_mph,
-                others_mph: case.others_mph,
-            })
-            .collect())
+    /// The test bed of the base config: speed cases, headways and seeds.
+    pub fn testbed(&self) -> &TestbedConfig {
+        &self.testbed
     }
 
     /// The learning config of one run.
-    pub fn config(&self, spec: &RunSpec) -> anyhow::Result<LearnConfig> {
+    pub fn config(&self, spec: &RunSpec) -> Result<LearnConfig, EvalError> {
         let mut config = self.base.clone();
-        config.method = Method::named(&spec.method)
-            .with_context(|| format!("unknown method `{}`", spec.method))?;
+        config.method = spec.method;
         config.cell = CellChoice {
             speed_case: spec.speed_case.name.clone(),
             headway_m: spec.headway_m,
@@ -68,17 +66,21 @@ impl HarnessRuns {
         if let Some(margin) = spec.horizon_margin_s {
             config.planning.horizon_margin_s = margin;
         }
-        config
-            .validate()
-            .with_context(|| format!("run `{}`", spec.label()))?;
+        config.validate().map_err(|source| EvalError::Run {
+            run: spec.label(),
+            source,
+        })?;
         Ok(config)
     }
 
     /// Runs the qualitative example and keeps every lane change.
-    pub fn example(&self, spec: &RunSpec) -> anyhow::Result<ExampleTrace> {
+    pub fn example(&self, spec: &RunSpec) -> Result<ExampleTrace, EvalError> {
         let config = self.config(spec)?;
-        let result = palc_harness::run(&config, None, &mut NoObserver)
-            .with_context(|| format!("the example run `{}`", spec.label()))?;
+        let result =
+            palc_harness::run(&config, None, &mut NoObserver).map_err(|source| EvalError::Run {
+                run: format!("the example {}", spec.label()),
+                source,
+            })?;
         Ok(ExampleTrace::from_result(&result))
     }
 }
@@ -93,7 +95,7 @@ impl Executor for HarnessRuns {
             Ok(config) => config,
             Err(error) => {
                 let status = Status::Failed {
-                    error: format!("{error:#}"),
+                    error: error.to_string(),
                 };
                 return (RunRow::without_result(spec.clone(), status, cap, 0.0), None);
             }
@@ -165,6 +167,7 @@ fn iteration(record: &LaneChangeRecord) -> Iteration {
             t.correction_s,
             t.plan_s,
         ],
+        learning_error: record.learning_error.clone(),
     }
 }
 

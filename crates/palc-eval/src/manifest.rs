@@ -68,16 +68,9 @@ pub fn git_state() -> (Option<String>, Option<bool>) {
     (commit, dirty)
 }
 
-/// The workspace version of `Cargo.toml` (`[workspace.package] version`), which
-/// every palc crate carries; "unknown" when it cannot be read.
+/// palc's version: the workspace version every palc crate carries.
 pub fn palc_version() -> String {
-    let manifest = std::fs::read_to_string(crate::project_root().join("Cargo.toml")).ok();
-    let table: Option<toml::Table> = manifest.and_then(|text| text.parse().ok());
-    table
-        .as_ref()
-        .and_then(|t| t.get("workspace")?.get("package")?.get("version")?.as_str())
-        .unwrap_or("unknown")
-        .to_owned()
+    env!("CARGO_PKG_VERSION").to_owned()
 }
 
 /// Logical cores, or 1 when unknown.

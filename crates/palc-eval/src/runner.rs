@@ -1,17 +1,17 @@
-//! Running the plan in parallel: rayon on `--jobs` threads, results collected by
-//! run index so that every output is the same whatever the number of threads.
+//! Running the plan in parallel: rayon on a fixed number of threads, results
+//! collected by run index so that every output is the same whatever the number
+//! of threads.
+//!
+//! The runner prints nothing: it reports each finished run to a [`Progress`],
+//! which a binary turns into a progress bar or log lines.
 
 use std::collections::HashMap;
-use std::io::IsTerminal;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::time::{Duration, Instant};
 
-use anyhow::Context;
-use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 
-use super::plan::{RunPlan, RunSpec};
-use super::results::{RunRow, Status};
+use crate::EvalError;
+use crate::plan::{RunPlan, RunSpec};
+use crate::results::{RunRow, Status};
 
 /// Runs one spec. The harness implements it (`harness_runs.rs`); tests use
 /// synthetic executors.
@@ -31,83 +31,33 @@ pub trait Executor: Sync {
     fn cap(&self) -> usize;
 }
 
-/// Shows progress: a bar with ETA on a terminal, a plain line every 5 % otherwise.
-pub struct Progress {
-    bar: Option<ProgressBar>,
-    total: usize,
-    done: AtomicUsize,
-    start: Instant,
-    quiet: bool,
+/// Watches the runs of an evaluation; called from the worker threads.
+pub trait Progress: Sync {
+    /// Called once before the first run with the number of runs.
+    fn started(&self, _total: usize) {}
+    /// Called after each run, in the order runs finish.
+    fn finished(&self, _row: &RunRow) {}
+    /// Called once after the last run.
+    fn done(&self) {}
 }
 
-impl Progress {
-    /// Progress over `total` runs; `quiet` prints nothing (tests).
-    pub fn new(total: usize, quiet: bool) -> Progress {
-        let bar = (!quiet && std::io::stdout().is_terminal()).then(|| {
-            let bar = ProgressBar::new(total as u64);
-            bar.set_style(
-                ProgressStyle::with_template(
-                    "{elapsed_precise} [{bar:40}] {pos}/{len} runs, ETA {eta} {msg}",
-                )
-                .unwrap_or_else(|_| ProgressStyle::default_bar())
-                .progress_chars("=> "),
-            );
-            bar
-        });
-        Progress {
-            bar,
-            total,
-            done: AtomicUsize::new(0),
-            start: Instant::now(),
-            quiet,
-        }
-    }
+/// A [`Progress`] that shows nothing.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct NoProgress;
 
-    fn finished(&self, row: &RunRow) {
-        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
-        if let Some(bar) = &self.bar {
-            bar.set_message(format!("{} {}", row.spec.method, row.status.name()));
-            bar.inc(1);
-            return;
-        }
-        if self.quiet {
-            return;
-        }
-        let step = (self.total / 20).max(1);
-        if done % step == 0 || done == self.total {
-            let elapsed = self.start.elapsed().as_secs_f64();
-            let eta = elapsed / done as f64 * (self.total - done) as f64;
-            println!(
-                "[{done}/{total}] {elapsed:.0} s elapsed, about {eta:.0} s left",
-                total = self.total
-            );
-        }
-    }
-
-    /// Ends the bar.
-    pub fn finish(&self) {
-        if let Some(bar) = &self.bar {
-            bar.finish_with_message("done");
-        }
-    }
-
-    /// Time since the start.
-    pub fn elapsed(&self) -> Duration {
-        self.start.elapsed()
-    }
-}
+impl Progress for NoProgress {}
 
 /// Runs every spec of `plan` on `jobs` threads; the rows are in plan order.
 pub fn execute<E: Executor>(
     plan: &RunPlan,
     executor: &E,
     jobs: usize,
-    progress: &Progress,
-) -> anyhow::Result<Vec<RunRow>> {
+    progress: &dyn Progress,
+) -> Result<Vec<RunRow>, EvalError> {
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(jobs)
-        .build()
-        .context("cannot start the thread pool")?;
+        .num_threads(jobs.max(1))
+        .build()?;
+    progress.started(plan.len());
     let sources: Vec<usize> = plan
         .transfer
         .iter()
@@ -164,15 +114,8 @@ pub fn execute<E: Executor>(
             .collect()
     });
     rows.extend(transfer);
-    progress.finish();
-    for (index, row) in rows.iter().enumerate() {
-        anyhow::ensure!(
-            row.spec.id == index,
-            "run {} came back as {}",
-            index,
-            row.spec.id
-        );
-    }
+    progress.done();
+    debug_assert!(rows.iter().enumerate().all(|(i, row)| row.spec.id == i));
     Ok(rows)
 }
 
@@ -184,9 +127,10 @@ impl RunSpec {
 
 #[cfg(test)]
 pub(crate) mod tests {
-    use super::super::plan::{self, Experiment};
-    use super::super::results::Iteration;
     use super::*;
+    use crate::plan::{self, Experiment};
+    use crate::results::Iteration;
+    use palc_harness::Method;
 
     /// A deterministic stand-in for the harness: the outcome is a function of
     /// the spec (and of whether experience was given), never of the thread.
@@ -202,7 +146,11 @@ pub(crate) mod tests {
                 _ => 6,
             };
             let base = style + (spec.seed as usize % 3) + (spec.headway_m < 40.0) as usize;
-            let takeovers = if spec.method == "paper" { 30 } else { base };
+            let takeovers = if spec.method == Method::Paper {
+                30
+            } else {
+                base
+            };
             let takeovers = match experience {
                 Some(_) => takeovers * 3 / 4,
                 None => takeovers,
@@ -241,6 +189,7 @@ pub(crate) mod tests {
                         0.02,
                         0.005 * spec.dt.unwrap_or(0.1) * 10.0,
                     ],
+                    learning_error: None,
                 })
                 .collect();
             let dt = spec.dt.unwrap_or(0.1);
@@ -267,15 +216,15 @@ pub(crate) mod tests {
     }
 
     pub(crate) fn synthetic_rows() -> Vec<RunRow> {
-        let plan = plan::expand(&plan::tests::selection(), &plan::tests::speed_cases()).unwrap();
-        execute(&plan, &Synthetic, 2, &Progress::new(plan.len(), true)).unwrap()
+        let plan = plan::expand(&plan::tests::selection(), &plan::tests::testbed()).unwrap();
+        execute(&plan, &Synthetic, 2, &NoProgress).unwrap()
     }
 
     #[test]
     fn results_do_not_depend_on_the_number_of_threads() {
-        let plan = plan::expand(&plan::tests::selection(), &plan::tests::speed_cases()).unwrap();
-        let one = execute(&plan, &Synthetic, 1, &Progress::new(plan.len(), true)).unwrap();
-        let three = execute(&plan, &Synthetic, 3, &Progress::new(plan.len(), true)).unwrap();
+        let plan = plan::expand(&plan::tests::selection(), &plan::tests::testbed()).unwrap();
+        let one = execute(&plan, &Synthetic, 1, &NoProgress).unwrap();
+        let three = execute(&plan, &Synthetic, 3, &NoProgress).unwrap();
         assert_eq!(one, three);
         assert_eq!(one.len(), plan.len());
     }

@@ -3,10 +3,12 @@
 //! The order of the list is the order of every output, whatever the number of
 //! threads: runs are executed in parallel but collected by index.
 
-use anyhow::{Context, bail};
+use palc_harness::Method;
+use palc_traffic::{SpeedCaseConfig, TestbedConfig};
 use serde::{Deserialize, Serialize};
 
-use super::config::{Selection, TransferSource, UserKind};
+use crate::EvalError;
+use crate::config::{Selection, TransferSource, UserKind, speed_case};
 
 /// The experiment a run belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -31,17 +33,6 @@ impl Experiment {
     }
 }
 
-/// A speed case with its speeds, looked up in the base config.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct SpeedCase {
-    /// Name, e.g. `collector-high`.
-    pub name: String,
-    /// Ego speed (mph).
-    pub ego_mph: f64,
-    /// Speed of the surrounding traffic (mph).
-    pub others_mph: f64,
-}
-
 /// One run of the loop: everything that differs from the base config.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunSpec {
@@ -49,14 +40,14 @@ pub struct RunSpec {
     pub id: usize,
     /// Which experiment.
     pub experiment: Experiment,
-    /// `paper` or `palc`.
-    pub method: String,
+    /// The learning method.
+    pub method: Method,
     /// The user kind.
     pub user: UserKind,
     /// Style name.
     pub style: String,
-    /// Speed case.
-    pub speed_case: SpeedCase,
+    /// Speed case, with its speeds.
+    pub speed_case: SpeedCaseConfig,
     /// Adjacent headway (m).
     pub headway_m: f64,
     /// Scene seed (and seed of the user's draws).
@@ -71,13 +62,13 @@ pub struct RunSpec {
 
 /// What identifies a scenario and user apart from the experiment: a transfer
 /// run and the grid run of the same cell share it.
-pub type CellKey = (String, String, String, String, u64, u64);
+pub type CellKey = (&'static str, String, String, String, u64, u64);
 
 impl RunSpec {
     /// The cell of this run: method, user, style, speed case, headway bits, seed.
     pub fn experiment_cell(&self) -> CellKey {
         (
-            self.method.clone(),
+            self.method.name(),
             self.user.name.clone(),
             self.style.clone(),
             self.speed_case.name.clone(),
@@ -91,7 +82,7 @@ impl RunSpec {
         let mut label = format!(
             "{} {} {} {} / {} m / seed {} / {}",
             self.experiment.name(),
-            self.method,
+            self.method.name(),
             self.user.name,
             self.style,
             self.headway_m,
@@ -131,18 +122,8 @@ impl RunPlan {
     }
 }
 
-/// Expands a selection; `speed_cases` are the base config's (name, ego, others).
-pub fn expand(selection: &Selection, speed_cases: &[SpeedCase]) -> anyhow::Result<RunPlan> {
-    let lookup = |name: &str| -> anyhow::Result<SpeedCase> {
-        speed_cases
-            .iter()
-            .find(|case| case.name == name)
-            .cloned()
-            .with_context(|| {
-                let names: Vec<&str> = speed_cases.iter().map(|c| c.name.as_str()).collect();
-                format!("unknown speed case `{name}`: the base config defines {names:?}")
-            })
-    };
+/// Expands a selection; the timing runs' speed case is looked up in `testbed`.
+pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan, EvalError> {
     let grid = &selection.grid;
     let mut first = Vec::new();
     for method in &grid.methods {
@@ -154,10 +135,10 @@ pub fn expand(selection: &Selection, speed_cases: &[SpeedCase]) -> anyhow::Resul
                             first.push(RunSpec {
                                 id: first.len(),
                                 experiment: Experiment::Grid,
-                                method: method.clone(),
+                                method: *method,
                                 user: user.clone(),
                                 style: style.clone(),
-                                speed_case: lookup(case)?,
+                                speed_case: case.clone(),
                                 headway_m,
                                 seed,
                                 dt: None,
@@ -171,10 +152,8 @@ pub fn expand(selection: &Selection, speed_cases: &[SpeedCase]) -> anyhow::Resul
         }
     }
     let timing = &selection.timing;
-    let deterministic = UserKind {
-        name: "deterministic".to_owned(),
-        spread_relative: None,
-    };
+    let timing_case = speed_case(testbed, &timing.speed_case, "timing.speed_case")?;
+    let deterministic = UserKind::deterministic();
     for method in &timing.methods {
         for &dt in &timing.dts {
             for &margin in &timing.horizon_margins_s {
@@ -182,10 +161,10 @@ pub fn expand(selection: &Selection, speed_cases: &[SpeedCase]) -> anyhow::Resul
                     first.push(RunSpec {
                         id: first.len(),
                         experiment: Experiment::Timing,
-                        method: method.clone(),
+                        method: *method,
                         user: deterministic.clone(),
                         style: style.clone(),
-                        speed_case: lookup(&timing.speed_case)?,
+                        speed_case: timing_case.clone(),
                         headway_m: timing.headway_m,
                         seed: timing.seed,
                         dt: Some(dt),
@@ -201,7 +180,7 @@ pub fn expand(selection: &Selection, speed_cases: &[SpeedCase]) -> anyhow::Resul
         if !selection.transfer.users.contains(&target.user.name) {
             continue;
         }
-        let source = transfer_source(selection, target, &first)?;
+        let source = transfer_source(selection, target, &first);
         let Some(source) = source else { continue };
         transfer.push(RunSpec {
             id: first.len() + transfer.len(),
@@ -215,36 +194,24 @@ pub fn expand(selection: &Selection, speed_cases: &[SpeedCase]) -> anyhow::Resul
 
 /// The phase-one grid run whose experience `target` starts from; `None` when the
 /// grid has a single speed case (or headway), so that there is no other scenario.
-fn transfer_source(
-    selection: &Selection,
-    target: &RunSpec,
-    first: &[RunSpec],
-) -> anyhow::Result<Option<usize>> {
+fn transfer_source(selection: &Selection, target: &RunSpec, first: &[RunSpec]) -> Option<usize> {
     let grid = &selection.grid;
     let next = |len: usize, index: usize| (index + 1) % len;
     let (case, headway) = match selection.transfer.source {
         TransferSource::NextSpeedCase => {
-            if grid.speed_cases.len() < 2 {
-                return Ok(None);
-            }
-            let i = position(&grid.speed_cases, &target.speed_case.name)?;
-            (
-                grid.speed_cases[next(grid.speed_cases.len(), i)].clone(),
-                target.headway_m,
-            )
+            let cases = &grid.speed_cases;
+            let i = cases
+                .iter()
+                .position(|c| c.name == target.speed_case.name)?;
+            let case = &cases[next(cases.len(), i)];
+            (case.name.as_str(), target.headway_m)
         }
         TransferSource::NextHeadway => {
-            if grid.headways_m.len() < 2 {
-                return Ok(None);
-            }
-            let i = grid
-                .headways_m
-                .iter()
-                .position(|&h| h == target.headway_m)
-                .context("a grid run's headway is in the grid")?;
+            let headways = &grid.headways_m;
+            let i = headways.iter().position(|&h| h == target.headway_m)?;
             (
-                target.speed_case.name.clone(),
-                grid.headways_m[next(grid.headways_m.len(), i)],
+                target.speed_case.name.as_str(),
+                headways[next(headways.len(), i)],
             )
         }
     };
@@ -256,60 +223,53 @@ fn transfer_source(
             && s.seed == target.seed
             && s.speed_case.name == case
             && s.headway_m == headway
-    });
-    match source {
-        Some(source) => Ok(Some(source.id)),
-        None => bail!(
-            "no grid run to take experience from for `{}`",
-            target.label()
-        ),
-    }
-}
-
-fn position(names: &[String], name: &str) -> anyhow::Result<usize> {
-    names
-        .iter()
-        .position(|n| n == name)
-        .with_context(|| format!("`{name}` is not in the grid"))
+    })?;
+    // A single speed case (or headway) has no other scenario to learn from.
+    (source.id != target.id).then_some(source.id)
 }
 
 #[cfg(test)]
 pub(crate) mod tests {
-    use super::super::config::{
-        ExampleConfig, GridConfig, TimingConfig, TransferConfig, TransferSource,
-    };
     use super::*;
+    use crate::config::{ExampleConfig, Grid, TimingConfig, TransferConfig, TransferSource};
 
-    pub(crate) fn speed_cases() -> Vec<SpeedCase> {
-        [
+    /// The paper's four speed cases (Section III.A).
+    pub(crate) fn testbed() -> TestbedConfig {
+        let speed_cases = [
             ("collector-high", 45.0, 40.0),
             ("collector-slow", 45.0, 35.0),
             ("arterial-high", 65.0, 60.0),
             ("arterial-slow", 65.0, 55.0),
         ]
         .into_iter()
-        .map(|(name, ego_mph, others_mph)| SpeedCase {
+        .map(|(name, ego_mph, others_mph)| SpeedCaseConfig {
             name: name.to_owned(),
             ego_mph,
             others_mph,
         })
-        .collect()
+        .collect();
+        let text = include_str!("../../../configs/learn.toml");
+        let mut testbed = (palc_harness::LearnConfig::from_toml_str(text).unwrap())
+            .traffic
+            .testbed
+            .unwrap();
+        testbed.speed_cases = speed_cases;
+        testbed
     }
 
     pub(crate) fn selection() -> Selection {
+        let testbed = testbed();
+        let case = |name: &str| speed_case(&testbed, name, "test").unwrap();
         Selection {
-            grid: GridConfig {
-                methods: vec!["paper".into(), "palc".into()],
-                speed_cases: vec!["collector-high".into(), "arterial-slow".into()],
+            grid: Grid {
+                methods: vec![Method::Paper, Method::Palc],
+                speed_cases: vec![case("collector-high"), case("arterial-slow")],
                 headways_m: vec![50.0, 30.0],
                 styles: vec!["aggressive".into(), "neutral".into(), "cautious".into()],
                 seeds: vec![1, 2],
             },
             users: vec![
-                UserKind {
-                    name: "deterministic".into(),
-                    spread_relative: None,
-                },
+                UserKind::deterministic(),
                 UserKind {
                     name: "spread".into(),
                     spread_relative: Some(0.02),
@@ -320,7 +280,7 @@ pub(crate) mod tests {
                 users: vec!["deterministic".into()],
             },
             timing: TimingConfig {
-                methods: vec!["palc".into()],
+                methods: vec![Method::Palc],
                 dts: vec![0.1, 0.05],
                 horizon_margins_s: vec![0.0, 1.0],
                 styles: vec!["neutral".into()],
@@ -329,7 +289,7 @@ pub(crate) mod tests {
                 seed: 1,
             },
             example: ExampleConfig {
-                method: "palc".into(),
+                method: Method::Palc,
                 style: "aggressive".into(),
                 speed_case: "collector-high".into(),
                 headway_m: 40.0,
@@ -340,7 +300,7 @@ pub(crate) mod tests {
 
     #[test]
     fn the_grid_expands_to_every_combination_with_dense_ids() {
-        let plan = expand(&selection(), &speed_cases()).unwrap();
+        let plan = expand(&selection(), &testbed()).unwrap();
         let grid = plan
             .first
             .iter()
@@ -362,20 +322,20 @@ pub(crate) mod tests {
 
     #[test]
     fn a_transfer_run_takes_the_same_user_from_the_next_speed_case() {
-        let plan = expand(&selection(), &speed_cases()).unwrap();
+        let plan = expand(&selection(), &testbed()).unwrap();
         for target in &plan.transfer {
             let source = &plan.first[target.experience_from.unwrap()];
             assert_eq!(source.experiment, Experiment::Grid);
             assert_eq!(
                 (
-                    &source.method,
+                    source.method,
                     &source.user,
                     &source.style,
                     source.seed,
                     source.headway_m
                 ),
                 (
-                    &target.method,
+                    target.method,
                     &target.user,
                     &target.style,
                     target.seed,
@@ -387,10 +347,21 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn an_unknown_speed_case_is_named() {
+    fn a_single_speed_case_has_no_transfer_run() {
         let mut selection = selection();
-        selection.grid.speed_cases.push("autobahn".into());
-        let error = expand(&selection, &speed_cases()).unwrap_err().to_string();
-        assert!(error.contains("autobahn"), "{error}");
+        selection.grid.speed_cases.truncate(1);
+        let plan = expand(&selection, &testbed()).unwrap();
+        assert!(plan.transfer.is_empty());
+    }
+
+    #[test]
+    fn an_unknown_timing_speed_case_is_named() {
+        let mut selection = selection();
+        selection.timing.speed_case = "autobahn".into();
+        let error = expand(&selection, &testbed()).unwrap_err().to_string();
+        assert!(
+            error.contains("autobahn") && error.contains("timing.speed_case"),
+            "{error}"
+        );
     }
 }

@@ -7,14 +7,17 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::anyhow;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::register_font;
 
-use super::harness_runs::ExampleTrace;
+use crate::EvalError;
+use crate::harness_runs::ExampleTrace;
 
-static DEJAVU_SANS: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
+/// What drawing returns: the backend's message on failure.
+pub type DrawResult = Result<(), String>;
+
+static DEJAVU_SANS: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
 
 /// The font family every figure uses.
 const FONT: &str = "sans-serif";
@@ -30,19 +33,21 @@ const COLOURS: [RGBColor; 6] = [
 ];
 
 /// Registers the bundled font under the family name the figures use.
-pub fn register_bundled_font() -> anyhow::Result<()> {
-    register_font(FONT, FontStyle::Normal, DEJAVU_SANS)
-        .map_err(|_| anyhow!("the bundled font assets/DejaVuSans.ttf cannot be read"))
+pub fn register_bundled_font() -> Result<(), EvalError> {
+    register_font(FONT, FontStyle::Normal, DEJAVU_SANS).map_err(|_| EvalError::Figure {
+        figure: "every figure".to_owned(),
+        message: "the bundled font assets/DejaVuSans.ttf cannot be read".to_owned(),
+    })
 }
 
-fn plot_error(error: impl std::fmt::Display) -> anyhow::Error {
-    anyhow!("cannot draw the figure: {error}")
+fn plot_error(error: impl std::fmt::Display) -> String {
+    error.to_string()
 }
 
 /// A figure that can be drawn on any plotters backend.
 pub trait Figure {
     /// Draws on `root`.
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()>;
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult;
 }
 
 /// Writes `stem.svg` and `stem.png` under `dir`; returns both paths.
@@ -51,9 +56,17 @@ pub fn save<F: Figure>(
     stem: &str,
     size: (u32, u32),
     figure: &F,
-) -> anyhow::Result<[PathBuf; 2]> {
+) -> Result<[PathBuf; 2], EvalError> {
     let svg = dir.join(format!("{stem}.svg"));
     let png = dir.join(format!("{stem}.png"));
+    draw_both(&svg, &png, size, figure).map_err(|message| EvalError::Figure {
+        figure: stem.to_owned(),
+        message,
+    })?;
+    Ok([svg, png])
+}
+
+fn draw_both<F: Figure>(svg: &Path, png: &Path, size: (u32, u32), figure: &F) -> DrawResult {
     {
         let root = SVGBackend::new(&svg, size).into_drawing_area();
         root.fill(&WHITE).map_err(plot_error)?;
@@ -66,7 +79,7 @@ pub fn save<F: Figure>(
         figure.draw(&root)?;
         root.present().map_err(plot_error)?;
     }
-    Ok([svg, png])
+    Ok(())
 }
 
 /// Grouped bars: one group per category, one bar per series; a missing value
@@ -87,14 +100,14 @@ pub struct Bars {
 }
 
 impl Figure for Bars {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         let n = self.categories.len().max(1);
         let top = (self.series.iter())
             .flat_map(|(_, values)| values.iter().flatten())
             .fold(0.0f64, |a, &b| a.max(b));
         let top = if top > 0.0 { top * 1.15 } else { 1.0 };
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, (FONT, 22))
+        let (plot, legend_area) = with_legend_area(root, &self.title)?;
+        let mut chart = ChartBuilder::on(&plot)
             .margin(12)
             .x_label_area_size(45)
             .y_label_area_size(60)
@@ -122,7 +135,7 @@ impl Figure for Bars {
             .map_err(plot_error)?;
         let groups = self.series.len().max(1) as f64;
         let width = 0.8 / groups;
-        for (s, (name, values)) in self.series.iter().enumerate() {
+        for (s, (_, values)) in self.series.iter().enumerate() {
             let colour = COLOURS[s % COLOURS.len()];
             let left = -0.4 + s as f64 * width;
             let bars = values.iter().enumerate().filter_map(|(c, v)| {
@@ -131,23 +144,12 @@ impl Figure for Bars {
                     Rectangle::new([(x0, 0.0), (x0 + width * 0.95, v)], colour.filled())
                 })
             });
-            chart
-                .draw_series(bars)
-                .map_err(plot_error)?
-                .label(name)
-                .legend(move |(x, y)| {
-                    Rectangle::new([(x, y - 5), (x + 12, y + 5)], colour.filled())
-                });
+            chart.draw_series(bars).map_err(plot_error)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT, 14))
-            .draw()
-            .map_err(plot_error)?;
-        Ok(())
+        let entries: Vec<(&str, RGBColor)> = (self.series.iter().enumerate())
+            .map(|(s, (name, _))| (name.as_str(), COLOURS[s % COLOURS.len()]))
+            .collect();
+        legend(&legend_area, &entries, Swatch::Box)
     }
 }
 
@@ -161,12 +163,14 @@ pub struct Lines {
     pub y_desc: String,
     /// Series: name and points.
     pub series: Vec<(String, Vec<(f64, f64)>)>,
-    /// Fixed y range, or from the data.
+    /// Fixed y range, or from the data (ignored with `log_y`).
     pub y_range: Option<(f64, f64)>,
+    /// A logarithmic y axis, for values that span decades (whole decades from the data).
+    pub log_y: bool,
 }
 
 impl Figure for Lines {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         let points = || self.series.iter().flat_map(|(_, p)| p.iter());
         let (x0, x1) = points().fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
             (a.min(p.0), b.max(p.0))
@@ -181,47 +185,120 @@ impl Figure for Lines {
             (0.0, if top > 0.0 { top * 1.15 } else { 1.0 })
         });
         let pad = (x1 - x0) * 0.03;
-        let mut chart = ChartBuilder::on(root)
-            .caption(&self.title, (FONT, 22))
+        let (plot, legend_area) = with_legend_area(root, &self.title)?;
+        let y_value = |y: f64| if self.log_y { y.log10() } else { y };
+        let (y0, y1) = if self.log_y {
+            let positive = || points().map(|p| p.1).filter(|&y| y > 0.0);
+            let low = positive().fold(f64::INFINITY, f64::min);
+            let high = positive().fold(0.0f64, f64::max);
+            if low.is_finite() && high > 0.0 {
+                (
+                    low.log10().floor(),
+                    high.log10().ceil().max(low.log10().floor() + 1.0),
+                )
+            } else {
+                (0.0, 1.0)
+            }
+        } else {
+            (y0, y1)
+        };
+        let mut chart = ChartBuilder::on(&plot)
             .margin(12)
             .x_label_area_size(45)
             .y_label_area_size(70)
             .build_cartesian_2d((x0 - pad)..(x1 + pad), y0..y1)
             .map_err(plot_error)?;
-        chart
-            .configure_mesh()
-            .x_desc(&self.x_desc)
+        let y_label = |y: &f64| {
+            if self.log_y {
+                // Powers of ten at whole decades, nothing in between.
+                if (y - y.round()).abs() < 1e-9 {
+                    format!("{}", 10f64.powi(y.round() as i32))
+                } else {
+                    String::new()
+                }
+            } else {
+                format!("{y}")
+            }
+        };
+        let decades = (y1 - y0).round().max(1.0) as usize;
+        let mut mesh = chart.configure_mesh();
+        mesh.x_desc(&self.x_desc)
             .y_desc(&self.y_desc)
+            .y_label_formatter(&y_label)
             .label_style((FONT, 14))
-            .axis_desc_style((FONT, 16))
-            .draw()
-            .map_err(plot_error)?;
-        for (s, (name, series)) in self.series.iter().enumerate() {
+            .axis_desc_style((FONT, 16));
+        if self.log_y {
+            mesh.y_labels(decades * 4 + 1);
+        }
+        mesh.draw().map_err(plot_error)?;
+        for (s, (_, series)) in self.series.iter().enumerate() {
             let colour = COLOURS[s % COLOURS.len()];
+            let shown = || {
+                (series.iter())
+                    .filter(|p| !self.log_y || p.1 > 0.0)
+                    .map(|&(x, y)| (x, y_value(y)))
+            };
             chart
-                .draw_series(LineSeries::new(
-                    series.iter().copied(),
-                    colour.stroke_width(2),
-                ))
-                .map_err(plot_error)?
-                .label(name)
-                .legend(move |(x, y)| {
-                    PathElement::new([(x, y), (x + 16, y)], colour.stroke_width(2))
-                });
+                .draw_series(LineSeries::new(shown(), colour.stroke_width(2)))
+                .map_err(plot_error)?;
             chart
-                .draw_series(series.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+                .draw_series(shown().map(|p| Circle::new(p, 3, colour.filled())))
                 .map_err(plot_error)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font((FONT, 14))
-            .draw()
-            .map_err(plot_error)?;
-        Ok(())
+        let entries: Vec<(&str, RGBColor)> = (self.series.iter().enumerate())
+            .map(|(s, (name, _))| (name.as_str(), COLOURS[s % COLOURS.len()]))
+            .collect();
+        legend(&legend_area, &entries, Swatch::Line)
     }
+}
+
+/// Share of a figure's width kept for the legend, right of the plot.
+const LEGEND_WIDTH_PERCENT: u32 = 22;
+
+/// Titles `root` and splits it into the plot and, on its right, the legend's
+/// column, so that no legend hides data.
+fn with_legend_area<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    title: &str,
+) -> Result<(DrawingArea<DB, Shift>, DrawingArea<DB, Shift>), String> {
+    let titled = root.titled(title, (FONT, 22)).map_err(plot_error)?;
+    let width = titled.dim_in_pixel().0;
+    Ok(titled.split_horizontally(width * (100 - LEGEND_WIDTH_PERCENT) / 100))
+}
+
+/// How a legend entry shows its series.
+#[derive(Debug, Clone, Copy)]
+enum Swatch {
+    /// A filled box (bars).
+    Box,
+    /// A line (line series).
+    Line,
+}
+
+/// One legend entry per series, top down, in the legend's column.
+fn legend<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    entries: &[(&str, RGBColor)],
+    swatch: Swatch,
+) -> DrawResult {
+    for (i, &(name, colour)) in entries.iter().enumerate() {
+        let y = 40 + 24 * i as i32;
+        match swatch {
+            Swatch::Box => area
+                .draw(&Rectangle::new([(6, y - 6), (20, y + 6)], colour.filled()))
+                .map_err(plot_error)?,
+            Swatch::Line => area
+                .draw(&PathElement::new([(4, y), (22, y)], colour.stroke_width(2)))
+                .map_err(plot_error)?,
+        }
+        area.draw(&Text::new(
+            name.to_owned(),
+            (28, y - 7),
+            (FONT, 14).into_font().color(&BLACK),
+        ))
+        .map_err(plot_error)?;
+    }
+    Ok(())
 }
 
 /// Fig. 6: the lateral profiles of every lane change of one run, and the
@@ -232,7 +309,7 @@ pub struct Example<'a> {
 }
 
 impl Figure for Example<'_> {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> anyhow::Result<()> {
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
         let trace = self.trace;
         let outcome = if trace.personalized {
             format!("personalized after {} takeovers", trace.takeovers)
@@ -249,7 +326,7 @@ impl Figure for Example<'_> {
 }
 
 impl Example<'_> {
-    fn profiles<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> anyhow::Result<()> {
+    fn profiles<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> DrawResult {
         let trace = self.trace;
         let steps = (trace.lane_changes.iter())
             .map(|lc| lc.planned_l.len().max(lc.expected_l.len()))
@@ -338,7 +415,7 @@ impl Example<'_> {
         Ok(())
     }
 
-    fn heat_map<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> anyhow::Result<()> {
+    fn heat_map<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> DrawResult {
         let weights = &self.trace.weights;
         let columns = weights.len().max(1);
         let rows = self.trace.weight_names.len();
@@ -412,7 +489,7 @@ mod tests {
     #[test]
     fn bars_and_lines_render_to_svg_and_png_with_the_bundled_font() {
         register_bundled_font().unwrap();
-        let dir = std::env::temp_dir().join(format!("palc-xtask-figures-{}", std::process::id()));
+        let dir = std::env::temp_dir().join(format!("palc-eval-figures-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
         let bars = Bars {
             title: "takeovers by style".into(),
@@ -431,7 +508,28 @@ mod tests {
             y_desc: "ratio".into(),
             series: vec![("palc".into(), vec![(1.0, 0.2), (2.0, 0.6), (3.0, 1.0)])],
             y_range: Some((0.0, 1.05)),
+            log_y: false,
         };
+        let log = Lines {
+            title: "compute".into(),
+            x_desc: "K".into(),
+            y_desc: "ms (log scale)".into(),
+            series: vec![(
+                "palc".into(),
+                vec![(40.0, 0.01), (80.0, 0.4), (120.0, 25.0)],
+            )],
+            y_range: None,
+            log_y: true,
+        };
+        let [log_svg, _] = save(&dir, "log", (640, 400), &log).unwrap();
+        let log_text = std::fs::read_to_string(&log_svg).unwrap();
+        // Whole decades from 0.01 to 100 ms, each a tick label of its own.
+        for decade in ["0.01", "0.1", "1", "10", "100"] {
+            assert!(
+                log_text.lines().any(|line| line.trim() == decade),
+                "no {decade} tick: {log_text}"
+            );
+        }
         for [svg, png] in [
             save(&dir, "bars", (640, 400), &bars).unwrap(),
             save(&dir, "lines", (640, 400), &lines).unwrap(),

@@ -1,13 +1,15 @@
-//! The experiments of Section III as views of the runs: which rows each figure
-//! and table uses, and the figures drawn from them (Figs. 6-13).
+//! The figures of Section III drawn from the runs (Figs. 6-13).
 
 use std::path::Path;
 
-use super::figures::{self, Bars, Example, Lines};
-use super::harness_runs::ExampleTrace;
-use super::plan::Experiment;
-use super::results::{PART_NAMES, RunRow};
-use super::stats;
+use palc_harness::Method;
+
+use crate::EvalError;
+use crate::figures::{self, Bars, Example, Lines};
+use crate::harness_runs::ExampleTrace;
+use crate::results::{PART_NAMES, RunRow};
+use crate::stats;
+use crate::views::{FigureFile, grid, slug, speed_label, timing, with_transfer};
 
 /// Series of a bar chart: name and one value per category.
 type BarSeries = Vec<(String, Vec<Option<f64>>)>;
@@ -15,80 +17,18 @@ type BarSeries = Vec<(String, Vec<Option<f64>>)>;
 /// How rows are grouped into categories.
 type Key<'a> = &'a dyn Fn(&RunRow) -> String;
 
-/// A figure written to the output directory.
-#[derive(Debug, Clone, PartialEq)]
-pub struct FigureFile {
-    /// File stem; `stem.svg` and `stem.png` exist.
-    pub stem: String,
-    /// What it shows.
-    pub caption: String,
-}
-
-/// The grid rows (no experience) of one method and user kind, in plan order.
-pub fn grid<'a>(rows: &'a [RunRow], method: &str, user: &str) -> Vec<&'a RunRow> {
-    rows.iter()
-        .filter(|r| {
-            r.spec.experiment == Experiment::Grid
-                && r.spec.method == method
-                && r.spec.user.name == user
-        })
-        .collect()
-}
-
-/// Grid and transfer rows of one method and user kind.
-pub fn with_transfer<'a>(rows: &'a [RunRow], method: &str, user: &str) -> Vec<&'a RunRow> {
-    rows.iter()
-        .filter(|r| {
-            r.spec.experiment != Experiment::Timing
-                && r.spec.method == method
-                && r.spec.user.name == user
-        })
-        .collect()
-}
-
-/// The timing rows of one method.
-pub fn timing<'a>(rows: &'a [RunRow], method: &str) -> Vec<&'a RunRow> {
-    rows.iter()
-        .filter(|r| r.spec.experiment == Experiment::Timing && r.spec.method == method)
-        .collect()
-}
-
-/// A name usable in a file name.
-pub fn slug(name: &str) -> String {
-    name.chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() {
-                c.to_ascii_lowercase()
-            } else {
-                '-'
-            }
-        })
-        .collect::<String>()
-        .trim_matches('-')
-        .to_owned()
-}
-
-/// Speed-case label with its speeds.
-pub fn speed_label(row: &RunRow) -> String {
-    let case = &row.spec.speed_case;
-    format!(
-        "{} ({:.0}/{:.0} mph)",
-        case.name, case.ego_mph, case.others_mph
-    )
-}
-
 fn means_by(
     rows: &[RunRow],
-    methods: &[String],
+    methods: &[Method],
     user: &str,
     key: &dyn Fn(&RunRow) -> String,
 ) -> (Vec<String>, BarSeries) {
-    let all: Vec<&RunRow> = methods.iter().flat_map(|m| grid(rows, m, user)).collect();
+    let all: Vec<&RunRow> = methods.iter().flat_map(|&m| grid(rows, m, user)).collect();
     let categories: Vec<String> = stats::by(&all, key).into_iter().map(|(k, _)| k).collect();
     let series = methods
         .iter()
         .map(|method| {
-            let groups = stats::by(&grid(rows, method, user), key);
+            let groups = stats::by(&grid(rows, *method, user), key);
             let values = (categories.iter())
                 .map(|c| {
                     groups
@@ -97,7 +37,7 @@ fn means_by(
                         .and_then(|(_, s)| s.mean)
                 })
                 .collect();
-            (method.clone(), values)
+            (method.name().to_owned(), values)
         })
         .collect();
     (categories, series)
@@ -106,18 +46,18 @@ fn means_by(
 /// Draws every figure into `dir`.
 pub fn draw_all(
     rows: &[RunRow],
-    methods: &[String],
+    methods: &[Method],
     users: &[String],
     example: Option<&ExampleTrace>,
     dir: &Path,
-) -> anyhow::Result<Vec<FigureFile>> {
+) -> Result<Vec<FigureFile>, EvalError> {
     figures::register_bundled_font()?;
     let mut files = Vec::new();
     let mut save =
-        |stem: String, caption: String, figure: &dyn Fn(&Path, &str) -> anyhow::Result<()>| {
+        |stem: String, caption: String, figure: &dyn Fn(&Path, &str) -> Result<(), EvalError>| {
             figure(dir, &stem)?;
             files.push(FigureFile { stem, caption });
-            anyhow::Ok(())
+            Ok::<(), EvalError>(())
         };
     if let Some(trace) = example {
         save(
@@ -134,20 +74,20 @@ pub fn draw_all(
             .iter()
             .map(|method| {
                 let mut counts = vec![0usize; cap + 1];
-                for row in grid(rows, method, user)
+                for row in grid(rows, *method, user)
                     .iter()
                     .filter(|r| r.status.counted())
                 {
                     counts[row.counted_takeovers().min(cap)] += 1;
                 }
                 let counts = counts.into_iter().map(|c| Some(c as f64)).collect();
-                (method.clone(), counts)
+                (method.name().to_owned(), counts)
             })
             .collect();
         let histogram = Bars {
             title: format!("Takeovers to personalization ({user} users; {cap} = failed)"),
-            x_desc: "takeovers".into(),
-            y_desc: "runs".into(),
+            x_desc: "takeovers to personalization".into(),
+            y_desc: "runs (count)".into(),
             categories,
             series,
             label_every: 5,
@@ -197,13 +137,18 @@ pub fn draw_all(
         }
         let transfers: Vec<(String, stats::Transfer)> = methods
             .iter()
-            .map(|m| (m.clone(), stats::transfer(&with_transfer(rows, m, user))))
+            .map(|&m| {
+                (
+                    m.name().to_owned(),
+                    stats::transfer(&with_transfer(rows, m, user)),
+                )
+            })
             .filter(|(_, t)| t.pairs > 0)
             .collect();
         if !transfers.is_empty() {
             let figure = Bars {
                 title: format!("Experience accumulation ({user})"),
-                x_desc: String::new(),
+                x_desc: "start of the run".into(),
                 y_desc: "mean takeovers over the same cells".into(),
                 categories: vec!["without experience".into(), "with experience".into()],
                 series: transfers
@@ -222,19 +167,20 @@ pub fn draw_all(
         }
         let safety = Lines {
             title: format!("Perceived safety distance ratio ({user})"),
-            x_desc: "lane change".into(),
-            y_desc: "mean ratio over the runs still learning".into(),
+            x_desc: "lane change (index in the run)".into(),
+            y_desc: "perceived safety ratio, mean (-)".into(),
             series: methods
                 .iter()
-                .map(|m| {
+                .map(|&m| {
                     let s = stats::safety(&grid(rows, m, user));
                     let points = (s.mean_by_iteration.iter().enumerate())
                         .map(|(i, &(mean, _))| ((i + 1) as f64, mean))
                         .collect();
-                    (m.clone(), points)
+                    (m.name().to_owned(), points)
                 })
                 .collect(),
             y_range: Some((0.0, 1.05)),
+            log_y: false,
         };
         save(
             format!("fig12-safety-{tag}"),
@@ -245,7 +191,7 @@ pub fn draw_all(
         )?;
     }
     let mut series = Vec::new();
-    for method in methods {
+    for &method in methods {
         let timed = timing(rows, method);
         let mut dts: Vec<f64> = timed.iter().filter_map(|r| r.dt).collect();
         dts.sort_by(f64::total_cmp);
@@ -269,7 +215,7 @@ pub fn draw_all(
                 }
             }
             if !points.is_empty() {
-                series.push((format!("{method}, dt {dt} s"), points));
+                series.push((format!("{}, dt {dt} s", method.name()), points));
             }
         }
     }
@@ -277,9 +223,10 @@ pub fn draw_all(
         let figure = Lines {
             title: "Compute time per iteration, p95".into(),
             x_desc: "horizon K (steps)".into(),
-            y_desc: "ms".into(),
+            y_desc: "time per iteration, p95 (ms, log scale)".into(),
             series,
             y_range: None,
+            log_y: true,
         };
         save(
             "fig13-compute".into(),
@@ -288,15 +235,15 @@ pub fn draw_all(
         )?;
         let parts = Bars {
             title: "Compute time per iteration by part (mean)".into(),
-            x_desc: "part".into(),
-            y_desc: "ms".into(),
+            x_desc: "part of the iteration".into(),
+            y_desc: "mean time per iteration (ms)".into(),
             categories: PART_NAMES.iter().map(|s| s.to_string()).collect(),
             series: methods
                 .iter()
-                .filter_map(|m| {
+                .filter_map(|&m| {
                     let t = stats::timing(timing(rows, m))?;
                     Some((
-                        m.clone(),
+                        m.name().to_owned(),
                         t.part_means.iter().map(|v| Some(v * 1e3)).collect(),
                     ))
                 })

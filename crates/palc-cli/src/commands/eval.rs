@@ -1,0 +1,116 @@
+//! `palc eval`: runs an evaluation config (the paper's reproduction by
+//! default) through `palc-eval` and shows its progress.
+
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::time::Instant;
+
+use clap::Args;
+use indicatif::{ProgressBar, ProgressStyle};
+use palc_eval::{EvalOptions, Progress, RunRow, evaluate};
+
+/// Arguments of `palc eval` (and of `cargo xtask reproduce-paper`).
+#[derive(Debug, Args)]
+pub struct EvalArgs {
+    /// Run the config's small `[quick]` subset (about a minute on two cores).
+    #[arg(long)]
+    quick: bool,
+    /// Output directory.
+    #[arg(long, default_value = "target/reproduce-paper")]
+    out: PathBuf,
+    /// Worker threads (default: every core).
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// The evaluation config.
+    #[arg(long, default_value = "configs/reproduce.toml")]
+    config: PathBuf,
+}
+
+/// Shows progress: a bar with ETA on a terminal, a plain line every 5 % otherwise.
+struct Shown {
+    bar: Option<ProgressBar>,
+    total: AtomicUsize,
+    done: AtomicUsize,
+    start: Instant,
+}
+
+impl Shown {
+    fn new() -> Shown {
+        let bar = std::io::stdout().is_terminal().then(|| {
+            let bar = ProgressBar::new(0);
+            bar.set_style(
+                ProgressStyle::with_template(
+                    "{elapsed_precise} [{bar:40}] {pos}/{len} runs, ETA {eta} {msg}",
+                )
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> "),
+            );
+            bar
+        });
+        Shown {
+            bar,
+            total: AtomicUsize::new(0),
+            done: AtomicUsize::new(0),
+            start: Instant::now(),
+        }
+    }
+}
+
+impl Progress for Shown {
+    fn started(&self, total: usize) {
+        self.total.store(total, Ordering::Relaxed);
+        match &self.bar {
+            Some(bar) => bar.set_length(total as u64),
+            None => println!("{total} runs"),
+        }
+    }
+
+    fn finished(&self, row: &RunRow) {
+        let done = self.done.fetch_add(1, Ordering::Relaxed) + 1;
+        if let Some(bar) = &self.bar {
+            bar.set_message(format!("{} {}", row.spec.method.name(), row.status.name()));
+            bar.inc(1);
+            return;
+        }
+        let total = self.total.load(Ordering::Relaxed).max(1);
+        let step = (total / 20).max(1);
+        if done % step == 0 || done == total {
+            let elapsed = self.start.elapsed().as_secs_f64();
+            let eta = elapsed / done as f64 * total.saturating_sub(done) as f64;
+            println!("[{done}/{total}] {elapsed:.0} s elapsed, about {eta:.0} s left");
+        }
+    }
+
+    fn done(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_with_message("done");
+        }
+    }
+}
+
+/// Runs `palc eval`.
+pub fn run(args: EvalArgs) -> anyhow::Result<()> {
+    let options = EvalOptions {
+        config: args.config,
+        out: args.out,
+        quick: args.quick,
+        jobs: args.jobs,
+    };
+    println!(
+        "evaluating {}{} on {} threads",
+        options.config.display(),
+        if options.quick { " (quick subset)" } else { "" },
+        options
+            .jobs
+            .map_or_else(|| "all".to_owned(), |j| j.to_string())
+    );
+    let outcome = evaluate(&options, &Shown::new())?;
+    println!(
+        "{} runs in {:.1} s; report: {}",
+        outcome.runs,
+        outcome.wall_s,
+        outcome.report.display()
+    );
+    Ok(())
+}

@@ -1,0 +1,504 @@
+//! The evaluation config (`configs/reproduce.toml`): the whole evaluation in one file.
+//!
+//! The file names a base learning config (`configs/learn.toml`: traffic,
+//! planning, standard ALC, planner, loop) and says which runs to make from it:
+//! the grid of Section III (speed case x headway x style x seed), the methods,
+//! the users, the experience-transfer and timing experiments, the qualitative
+//! example and a `[quick]` subset. Every run overrides only its cell, user and
+//! method (and, in the timing experiment, the step and horizon margin).
+//!
+//! The grid has one definition: the speed cases, adjacent headways and seeds of
+//! `[grid]` default to the base config's `[traffic.testbed]`, which defines them;
+//! `[grid]` only narrows them (the `[quick]` subset does).
+
+use std::path::{Path, PathBuf};
+
+use palc_harness::Method;
+use palc_traffic::{SpeedCaseConfig, TestbedConfig};
+use serde::{Deserialize, Serialize};
+
+use crate::EvalError;
+
+/// The parsed evaluation config.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct EvalConfig {
+    /// Path of the base learning config, relative to this file.
+    pub base: PathBuf,
+    /// The grid of runs.
+    pub grid: GridConfig,
+    /// The users every grid cell is run with.
+    pub users: Vec<UserKind>,
+    /// Experience accumulation (Fig. 11).
+    pub transfer: TransferConfig,
+    /// Compute time against horizon and step (Fig. 13).
+    pub timing: TimingConfig,
+    /// The qualitative example (Fig. 6).
+    pub example: ExampleConfig,
+    /// The `--quick` subset.
+    pub quick: QuickConfig,
+}
+
+/// The grid of Section III: every combination is one run.
+///
+/// Speed cases, headways and seeds left out are those of the base config's
+/// `[traffic.testbed]`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridConfig {
+    /// Methods, `paper` and/or `palc`.
+    pub methods: Vec<Method>,
+    /// Names of speed cases of the base config's `[traffic.testbed]`; all by default.
+    #[serde(default)]
+    pub speed_cases: Option<Vec<String>>,
+    /// Adjacent headways (m); the test bed's by default.
+    #[serde(default)]
+    pub headways_m: Option<Vec<f64>>,
+    /// Style names.
+    pub styles: Vec<String>,
+    /// Scene seeds (with spread, the user's draws use the same seed); the test
+    /// bed's by default.
+    #[serde(default)]
+    pub seeds: Option<Vec<u64>>,
+}
+
+/// A grid with every list given: what a selection runs.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Grid {
+    /// Methods.
+    pub methods: Vec<Method>,
+    /// Speed cases, with their speeds.
+    pub speed_cases: Vec<SpeedCaseConfig>,
+    /// Adjacent headways (m).
+    pub headways_m: Vec<f64>,
+    /// Style names.
+    pub styles: Vec<String>,
+    /// Scene seeds.
+    pub seeds: Vec<u64>,
+}
+
+/// One kind of simulated user.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct UserKind {
+    /// Name in reports, e.g. `deterministic`.
+    pub name: String,
+    /// Relative spread of the user's headway and duration per lane change; none
+    /// for a deterministic user.
+    #[serde(default)]
+    pub spread_relative: Option<f64>,
+}
+
+impl UserKind {
+    /// The paper's user: the style's parameters in every lane change.
+    pub fn deterministic() -> UserKind {
+        UserKind {
+            name: "deterministic".to_owned(),
+            spread_relative: None,
+        }
+    }
+}
+
+/// Which run's experience a transfer run starts from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TransferSource {
+    /// The same user, method and seed in the next speed case of the grid (cyclic).
+    NextSpeedCase,
+    /// The same user, method and seed in the next headway of the grid (cyclic).
+    NextHeadway,
+}
+
+/// Experience accumulation: each grid cell run again from experience learned elsewhere.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TransferConfig {
+    /// Where the experience comes from.
+    pub source: TransferSource,
+    /// Names of the user kinds to run it for.
+    pub users: Vec<String>,
+}
+
+/// Compute time against the step `dt` and the horizon `K`.
+///
+/// The harness derives `K` from the scenario (the standard ALC's end plus a
+/// margin, over `dt`), so the experiment varies `dt` and the margin and reports
+/// the `K` each run used.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimingConfig {
+    /// Methods to time.
+    pub methods: Vec<Method>,
+    /// Steps (s).
+    pub dts: Vec<f64>,
+    /// Horizon margins after the standard ALC's end (s).
+    pub horizon_margins_s: Vec<f64>,
+    /// Styles.
+    pub styles: Vec<String>,
+    /// Speed case of the timed runs.
+    pub speed_case: String,
+    /// Adjacent headway of the timed runs (m).
+    pub headway_m: f64,
+    /// Seed of the timed runs.
+    pub seed: u64,
+}
+
+/// The qualitative example of Fig. 6: one run whose every lane change is kept.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExampleConfig {
+    /// Method.
+    pub method: Method,
+    /// Style (the paper shows an aggressive user).
+    pub style: String,
+    /// Speed case.
+    pub speed_case: String,
+    /// Adjacent headway (m).
+    pub headway_m: f64,
+    /// Seed.
+    pub seed: u64,
+}
+
+/// The `--quick` subset: its own grid, users and timing; transfer and example as above.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct QuickConfig {
+    /// The quick grid.
+    pub grid: GridConfig,
+    /// Names of the user kinds of the quick run.
+    pub users: Vec<String>,
+    /// The quick timing experiment.
+    pub timing: TimingConfig,
+}
+
+/// What one invocation runs: the full evaluation or the quick subset.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Selection {
+    /// The grid.
+    pub grid: Grid,
+    /// The users.
+    pub users: Vec<UserKind>,
+    /// The transfer experiment.
+    pub transfer: TransferConfig,
+    /// The timing experiment.
+    pub timing: TimingConfig,
+    /// The example.
+    pub example: ExampleConfig,
+}
+
+impl EvalConfig {
+    /// Parses and checks the config text.
+    pub fn from_toml_str(text: &str) -> Result<EvalConfig, EvalError> {
+        let config: EvalConfig = toml::from_str(text)?;
+        config.validate()?;
+        Ok(config)
+    }
+
+    /// The base learning config's path, resolved against the directory of `config_path`.
+    pub fn base_path(&self, config_path: &Path) -> PathBuf {
+        config_path
+            .parent()
+            .unwrap_or_else(|| Path::new("."))
+            .join(&self.base)
+    }
+
+    /// The full evaluation or, with `quick`, the quick subset, with the grid's
+    /// lists completed from the base config's test bed.
+    pub fn select(&self, quick: bool, testbed: &TestbedConfig) -> Result<Selection, EvalError> {
+        if !quick {
+            return Ok(Selection {
+                grid: self.grid.resolve("grid", testbed)?,
+                users: self.users.clone(),
+                transfer: self.transfer.clone(),
+                timing: self.timing.clone(),
+                example: self.example.clone(),
+            });
+        }
+        let users = (self.quick.users.iter())
+            .map(|name| self.user(name, "quick.users").cloned())
+            .collect::<Result<Vec<_>, _>>()?;
+        let transfer = TransferConfig {
+            users: (self.transfer.users.iter())
+                .filter(|name| self.quick.users.contains(name))
+                .cloned()
+                .collect(),
+            ..self.transfer.clone()
+        };
+        Ok(Selection {
+            grid: self.quick.grid.resolve("quick.grid", testbed)?,
+            users,
+            transfer,
+            timing: self.quick.timing.clone(),
+            example: self.example.clone(),
+        })
+    }
+
+    fn user(&self, name: &str, field: &str) -> Result<&UserKind, EvalError> {
+        self.users
+            .iter()
+            .find(|u| u.name == name)
+            .ok_or_else(|| EvalError::Unknown {
+                kind: "user kind",
+                name: name.to_owned(),
+                field: field.to_owned(),
+                known: self.users.iter().map(|u| u.name.clone()).collect(),
+            })
+    }
+
+    /// Checks every list is non-empty, every number in range and every name defined.
+    pub fn validate(&self) -> Result<(), EvalError> {
+        self.grid.validate("grid")?;
+        self.quick.grid.validate("quick.grid")?;
+        if self.users.is_empty() {
+            return Err(EvalError::invalid(
+                "users",
+                "empty",
+                "at least one user kind",
+            ));
+        }
+        for (i, user) in self.users.iter().enumerate() {
+            if let Some(spread) = user.spread_relative {
+                if !(spread.is_finite() && (0.0..0.5).contains(&spread)) {
+                    return Err(EvalError::invalid(
+                        format!("users[{i}].spread_relative"),
+                        format_args!("{spread:e}"),
+                        "a value in [0, 0.5)",
+                    ));
+                }
+            }
+            if self.users[..i].iter().any(|u| u.name == user.name) {
+                return Err(EvalError::invalid(
+                    format!("users[{i}].name"),
+                    format_args!("`{}`", user.name),
+                    "a name not defined before",
+                ));
+            }
+        }
+        for name in &self.transfer.users {
+            self.user(name, "transfer.users")?;
+        }
+        for name in &self.quick.users {
+            self.user(name, "quick.users")?;
+        }
+        if self.quick.users.is_empty() {
+            return Err(EvalError::invalid(
+                "quick.users",
+                "empty",
+                "at least one user kind",
+            ));
+        }
+        self.timing.validate("timing")?;
+        self.quick.timing.validate("quick.timing")?;
+        check_headway("example.headway_m", self.example.headway_m)
+    }
+}
+
+impl GridConfig {
+    fn validate(&self, table: &str) -> Result<(), EvalError> {
+        let optional_len = |list: &Option<Vec<_>>| list.as_ref().map(Vec::len);
+        for (field, len) in [
+            ("methods", Some(self.methods.len())),
+            ("speed_cases", self.speed_cases.as_ref().map(Vec::len)),
+            ("headways_m", optional_len(&self.headways_m)),
+            ("styles", Some(self.styles.len())),
+            ("seeds", self.seeds.as_ref().map(Vec::len)),
+        ] {
+            if len == Some(0) {
+                return Err(EvalError::invalid(
+                    format!("{table}.{field}"),
+                    "empty",
+                    "at least one entry (leave it out for the test bed's)",
+                ));
+            }
+        }
+        for &headway in self.headways_m.iter().flatten() {
+            check_headway(&format!("{table}.headways_m"), headway)?;
+        }
+        Ok(())
+    }
+
+    /// This grid with every list given, from `testbed` where it is left out.
+    pub fn resolve(&self, table: &str, testbed: &TestbedConfig) -> Result<Grid, EvalError> {
+        let speed_cases = match &self.speed_cases {
+            None => testbed.speed_cases.clone(),
+            Some(names) => names
+                .iter()
+                .map(|name| speed_case(testbed, name, &format!("{table}.speed_cases")))
+                .collect::<Result<_, _>>()?,
+        };
+        Ok(Grid {
+            methods: self.methods.clone(),
+            speed_cases,
+            headways_m: (self.headways_m.clone())
+                .unwrap_or_else(|| testbed.adjacent_headways_m.clone()),
+            styles: self.styles.clone(),
+            seeds: self.seeds.clone().unwrap_or_else(|| testbed.seeds.clone()),
+        })
+    }
+}
+
+impl Grid {
+    /// Number of cells per method and user.
+    pub fn cells(&self) -> usize {
+        self.speed_cases.len() * self.headways_m.len() * self.styles.len() * self.seeds.len()
+    }
+}
+
+/// The speed case `name` of the test bed; the error names `field` and the cases defined.
+pub fn speed_case(
+    testbed: &TestbedConfig,
+    name: &str,
+    field: &str,
+) -> Result<SpeedCaseConfig, EvalError> {
+    (testbed.speed_cases.iter())
+        .find(|case| case.name == name)
+        .cloned()
+        .ok_or_else(|| EvalError::Unknown {
+            kind: "speed case",
+            name: name.to_owned(),
+            field: field.to_owned(),
+            known: testbed.speed_cases.iter().map(|c| c.name.clone()).collect(),
+        })
+}
+
+impl TimingConfig {
+    fn validate(&self, table: &str) -> Result<(), EvalError> {
+        for (field, empty) in [
+            ("methods", self.methods.is_empty()),
+            ("dts", self.dts.is_empty()),
+            ("styles", self.styles.is_empty()),
+            ("horizon_margins_s", self.horizon_margins_s.is_empty()),
+        ] {
+            if empty {
+                return Err(EvalError::invalid(
+                    format!("{table}.{field}"),
+                    "empty",
+                    "at least one entry",
+                ));
+            }
+        }
+        for &dt in &self.dts {
+            if !(dt.is_finite() && dt > 0.0 && dt <= 0.5) {
+                return Err(EvalError::invalid(
+                    format!("{table}.dts"),
+                    format_args!("{dt:e}"),
+                    "a step in (0, 0.5] s",
+                ));
+            }
+        }
+        for &margin in &self.horizon_margins_s {
+            if !(margin.is_finite() && margin >= 0.0) {
+                return Err(EvalError::invalid(
+                    format!("{table}.horizon_margins_s"),
+                    format_args!("{margin:e}"),
+                    "a finite value >= 0 s",
+                ));
+            }
+        }
+        check_headway(&format!("{table}.headway_m"), self.headway_m)
+    }
+}
+
+fn check_headway(field: &str, headway: f64) -> Result<(), EvalError> {
+    if headway.is_finite() && headway > 0.0 {
+        Ok(())
+    } else {
+        Err(EvalError::invalid(
+            field,
+            format_args!("{headway:e}"),
+            "a finite headway > 0 m",
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const PROJECT_CONFIG: &str = include_str!("../../../configs/reproduce.toml");
+
+    fn project_config() -> EvalConfig {
+        EvalConfig::from_toml_str(PROJECT_CONFIG).expect("the project's config is valid")
+    }
+
+    fn testbed() -> TestbedConfig {
+        let text = include_str!("../../../configs/learn.toml");
+        let base = palc_harness::LearnConfig::from_toml_str(text).unwrap();
+        base.traffic.testbed.unwrap()
+    }
+
+    #[test]
+    fn the_project_config_parses_and_covers_the_paper_grid() {
+        let config = project_config();
+        let full = config.select(false, &testbed()).unwrap();
+        assert_eq!(full.grid.speed_cases.len(), 4);
+        assert_eq!(full.grid.headways_m, vec![50.0, 45.0, 40.0, 35.0, 30.0]);
+        assert_eq!(full.grid.seeds, vec![1, 2]);
+        assert_eq!(full.grid.styles.len(), 3);
+        assert_eq!(full.grid.methods, vec![Method::Paper, Method::Palc]);
+        assert!(config.users.iter().any(|u| u.spread_relative.is_none()));
+        assert!(config.users.iter().any(|u| u.spread_relative.is_some()));
+        assert!(config.timing.dts.contains(&0.05));
+        let quick = config.select(true, &testbed()).unwrap();
+        assert!(quick.grid.cells() < full.grid.cells());
+    }
+
+    #[test]
+    fn a_bad_value_is_named() {
+        let error = EvalConfig::from_toml_str(&PROJECT_CONFIG.replace(
+            "methods = [\"paper\", \"palc\"]",
+            "methods = [\"paper\", \"magic\"]",
+        ))
+        .unwrap_err()
+        .to_string();
+        assert!(error.contains("magic"), "{error}");
+
+        let mut config = project_config();
+        config.timing.dts = vec![0.0];
+        let error = config.validate().unwrap_err().to_string();
+        assert!(
+            error.contains("timing.dts") && error.contains("0e0"),
+            "{error}"
+        );
+
+        let mut config = project_config();
+        config.quick.users = vec!["nobody".to_owned()];
+        let error = config.validate().unwrap_err().to_string();
+        assert!(
+            error.contains("nobody") && error.contains("quick.users"),
+            "{error}"
+        );
+
+        let mut config = project_config();
+        config.users[0].spread_relative = Some(0.7);
+        let error = config.validate().unwrap_err().to_string();
+        assert!(
+            error.contains("spread_relative") && error.contains("7e-1"),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn an_unknown_speed_case_is_named_with_the_defined_ones() {
+        let mut config = project_config();
+        config.grid.speed_cases = Some(vec!["autobahn".to_owned()]);
+        let error = config.select(false, &testbed()).unwrap_err().to_string();
+        assert!(
+            error.contains("autobahn")
+                && error.contains("grid.speed_cases")
+                && error.contains("collector-high"),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn an_unknown_field_is_refused() {
+        let error = EvalConfig::from_toml_str("base = \"learn.toml\"\nbogus = 1\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("bogus") || error.contains("missing"),
+            "{error}"
+        );
+    }
+}

@@ -1,0 +1,105 @@
+//! Errors of the evaluation.
+
+use std::path::PathBuf;
+
+use thiserror::Error;
+
+/// What can go wrong while reading an evaluation config, running it or writing
+/// its outputs.
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum EvalError {
+    /// A file could not be read or written.
+    #[error("cannot {action} {}: {source}", path.display())]
+    Io {
+        /// `read`, `write` or `create`.
+        action: &'static str,
+        /// The file or directory.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// An error inside a config file, with the file's path.
+    #[error("in {}: {source}", path.display())]
+    InFile {
+        /// The config file.
+        path: PathBuf,
+        /// The error.
+        source: Box<EvalError>,
+    },
+    /// The TOML text could not be parsed (syntax, an unknown or missing field).
+    #[error("cannot parse the config: {0}")]
+    Toml(#[from] toml::de::Error),
+    /// A config value is out of its bound.
+    #[error("`{field}` is {value}, expected {bound}")]
+    InvalidConfig {
+        /// Dotted path of the field.
+        field: String,
+        /// The value found.
+        value: String,
+        /// The bound it violates.
+        bound: String,
+    },
+    /// A name (speed case, user kind) that the config does not define.
+    #[error("unknown {kind} `{name}` in `{field}`: defined are {known:?}")]
+    Unknown {
+        /// What kind of name.
+        kind: &'static str,
+        /// The name.
+        name: String,
+        /// Where it was found.
+        field: String,
+        /// The names that are defined.
+        known: Vec<String>,
+    },
+    /// The base learning config is invalid.
+    #[error("the base learning config: {0}")]
+    Harness(#[from] palc_harness::HarnessError),
+    /// The learning config of one run is invalid.
+    #[error("run `{run}`: {source}")]
+    Run {
+        /// The run's label.
+        run: String,
+        /// The cause.
+        source: palc_harness::HarnessError,
+    },
+    /// The worker threads could not start.
+    #[error("cannot start the thread pool: {0}")]
+    ThreadPool(#[from] rayon::ThreadPoolBuildError),
+    /// Results could not be serialized.
+    #[error("cannot serialize the results: {0}")]
+    Json(#[from] serde_json::Error),
+    /// `runs.csv` could not be written.
+    #[error("cannot write the CSV: {0}")]
+    Csv(#[from] csv::Error),
+    /// A figure could not be drawn.
+    #[error("cannot draw the figure `{figure}`: {message}")]
+    Figure {
+        /// The figure's file stem.
+        figure: String,
+        /// What the plotting backend said.
+        message: String,
+    },
+}
+
+impl EvalError {
+    /// Adds the path of the file the error is in.
+    pub fn in_file(self, path: impl Into<PathBuf>) -> EvalError {
+        EvalError::InFile {
+            path: path.into(),
+            source: Box::new(self),
+        }
+    }
+
+    pub(crate) fn invalid(
+        field: impl Into<String>,
+        value: impl std::fmt::Display,
+        bound: impl Into<String>,
+    ) -> EvalError {
+        EvalError::InvalidConfig {
+            field: field.into(),
+            value: value.to_string(),
+            bound: bound.into(),
+        }
+    }
+}

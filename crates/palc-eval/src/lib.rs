@@ -1,0 +1,267 @@
+//! The evaluation of palc (paper Section III, Figs. 6-13) as a library: the
+//! experiment config, the plan of runs, the parallel runner, the results
+//! (`runs.json`, `runs.csv`), the statistics, the paper's claims as data,
+//! REPORT.md and, with the default `plot` feature, the figures.
+//!
+//! `cargo xtask reproduce-paper` and `palc eval` both call [`evaluate`]; an
+//! embedder can run any evaluation config from Rust the same way, or take the
+//! pieces: [`Evaluation::load`] reads and checks the configs, [`Evaluation::plan`]
+//! expands them into runs, [`runner::execute`] runs them through the harness
+//! ([`HarnessRuns`]) on a fixed number of threads, and [`stats`], [`claims`] and
+//! [`report`] turn the rows into numbers and text.
+//!
+//! ```no_run
+//! use palc_eval::{EvalOptions, NoProgress, evaluate};
+//!
+//! let options = EvalOptions {
+//!     quick: true,
+//!     out: "target/my-eval".into(),
+//!     ..EvalOptions::default()
+//! };
+//! let outcome = evaluate(&options, &NoProgress)?;
+//! println!("{} runs, report at {}", outcome.runs, outcome.report.display());
+//! # Ok::<(), palc_eval::EvalError>(())
+//! ```
+//!
+//! Results do not depend on the number of threads: runs are collected by index,
+//! and every random draw comes from a seed of the config. The crate prints
+//! nothing; progress goes to a [`Progress`] that the caller supplies.
+#![warn(missing_docs)]
+#![warn(clippy::print_stdout, clippy::print_stderr)]
+
+pub mod claims;
+pub mod config;
+mod error;
+#[cfg(feature = "plot")]
+mod experiments;
+#[cfg(feature = "plot")]
+pub mod figures;
+pub mod harness_runs;
+pub mod manifest;
+pub mod plan;
+pub mod report;
+pub mod results;
+pub mod runner;
+pub mod stats;
+pub mod views;
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+pub use config::{EvalConfig, Selection};
+pub use error::EvalError;
+pub use harness_runs::{ExampleTrace, HarnessRuns};
+pub use plan::{Experiment, RunPlan, RunSpec};
+pub use results::{Iteration, RunRow, Status};
+pub use runner::{NoProgress, Progress};
+
+use manifest::Manifest;
+
+/// What to evaluate and where to write it; the defaults are the paper's
+/// reproduction, run from the workspace root.
+#[derive(Debug, Clone, PartialEq)]
+pub struct EvalOptions {
+    /// The evaluation config (TOML).
+    pub config: PathBuf,
+    /// Output directory.
+    pub out: PathBuf,
+    /// Run the config's `[quick]` subset.
+    pub quick: bool,
+    /// Worker threads; every core when `None`.
+    pub jobs: Option<usize>,
+}
+
+impl Default for EvalOptions {
+    fn default() -> Self {
+        EvalOptions {
+            config: PathBuf::from("configs/reproduce.toml"),
+            out: PathBuf::from("target/reproduce-paper"),
+            quick: false,
+            jobs: None,
+        }
+    }
+}
+
+/// What an evaluation wrote.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Outcome {
+    /// Path of REPORT.md.
+    pub report: PathBuf,
+    /// Runs made.
+    pub runs: usize,
+    /// Wall time of the runs (s).
+    pub wall_s: f64,
+}
+
+/// An evaluation config read and checked with its base learning config.
+#[derive(Debug)]
+pub struct Evaluation {
+    config_path: PathBuf,
+    base_path: PathBuf,
+    texts: [String; 2],
+    selection: Selection,
+    harness: HarnessRuns,
+    quick: bool,
+}
+
+fn read(path: &Path) -> Result<String, EvalError> {
+    std::fs::read_to_string(path).map_err(|source| EvalError::Io {
+        action: "read",
+        path: path.to_owned(),
+        source,
+    })
+}
+
+impl Evaluation {
+    /// Reads the evaluation config at `config_path` and the base learning config
+    /// it names, and checks both; `quick` selects the `[quick]` subset. Every
+    /// error names the file it is in.
+    pub fn load(config_path: &Path, quick: bool) -> Result<Evaluation, EvalError> {
+        let text = read(config_path)?;
+        let config = EvalConfig::from_toml_str(&text).map_err(|e| e.in_file(config_path))?;
+        let base_path = config.base_path(config_path);
+        let base_text = read(&base_path)?;
+        let base = palc_harness::LearnConfig::from_toml_str(&base_text)
+            .map_err(|e| EvalError::from(e).in_file(&base_path))?;
+        let harness = HarnessRuns::new(base).map_err(|e| e.in_file(&base_path))?;
+        let selection =
+            (config.select(quick, harness.testbed())).map_err(|e| e.in_file(config_path))?;
+        Ok(Evaluation {
+            config_path: config_path.to_owned(),
+            base_path,
+            texts: [text, base_text],
+            selection,
+            harness,
+            quick,
+        })
+    }
+
+    /// The runs of this evaluation, in output order.
+    pub fn plan(&self) -> Result<RunPlan, EvalError> {
+        plan::expand(&self.selection, self.harness.testbed())
+            .map_err(|e| e.in_file(&self.config_path))
+    }
+
+    /// What is run: grid, users, transfer, timing and example.
+    pub fn selection(&self) -> &Selection {
+        &self.selection
+    }
+
+    /// The runner of this evaluation's runs.
+    pub fn harness(&self) -> &HarnessRuns {
+        &self.harness
+    }
+
+    /// The qualitative example's run (Fig. 6).
+    pub fn example_spec(&self) -> Result<RunSpec, EvalError> {
+        let example = &self.selection.example;
+        let speed_case = config::speed_case(
+            self.harness.testbed(),
+            &example.speed_case,
+            "example.speed_case",
+        )
+        .map_err(|e| e.in_file(&self.config_path))?;
+        Ok(RunSpec {
+            id: usize::MAX,
+            experiment: Experiment::Grid,
+            method: example.method,
+            user: config::UserKind::deterministic(),
+            style: example.style.clone(),
+            speed_case,
+            headway_m: example.headway_m,
+            seed: example.seed,
+            dt: None,
+            horizon_margin_s: None,
+            experience_from: None,
+        })
+    }
+}
+
+/// Runs the whole evaluation described by `options` and writes its outputs:
+/// `runs.json`, `runs.csv`, `example.json`, `manifest.json`, the figures (with
+/// the `plot` feature) and `REPORT.md`. Nothing is written before both configs
+/// are read and checked and the runs are planned.
+pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcome, EvalError> {
+    let evaluation = Evaluation::load(&options.config, options.quick)?;
+    let plan = evaluation.plan()?;
+    let example_spec = evaluation.example_spec()?;
+    let jobs = options.jobs.unwrap_or_else(manifest::cores).max(1);
+    let out = &options.out;
+    std::fs::create_dir_all(out).map_err(|source| EvalError::Io {
+        action: "create",
+        path: out.clone(),
+        source,
+    })?;
+
+    let start = Instant::now();
+    let rows = runner::execute(&plan, &evaluation.harness, jobs, progress)?;
+    let wall_s = start.elapsed().as_secs_f64();
+    let example = evaluation
+        .harness
+        .example(&example_spec)
+        .map_err(|e| e.to_string());
+
+    let selection = &evaluation.selection;
+    let (git_commit, git_dirty) = manifest::git_state();
+    let manifest = Manifest {
+        palc_version: manifest::palc_version(),
+        git_commit,
+        git_dirty,
+        config_sha256: manifest::config_hash(&[&evaluation.texts[0], &evaluation.texts[1]]),
+        config_path: evaluation.config_path.display().to_string(),
+        base_path: evaluation.base_path.display().to_string(),
+        quick: evaluation.quick,
+        seeds: selection.grid.seeds.clone(),
+        threads: jobs,
+        cores: manifest::cores(),
+        machine: manifest::machine(),
+        runs: rows.len(),
+        wall_s,
+    };
+
+    results::write(&rows, &out.join("runs.json"), &out.join("runs.csv"))?;
+    if let Ok(trace) = &example {
+        write(
+            &out.join("example.json"),
+            &serde_json::to_string_pretty(trace)?,
+        )?;
+    }
+    write(
+        &out.join("manifest.json"),
+        &serde_json::to_string_pretty(&manifest)?,
+    )?;
+    let user_names: Vec<String> = selection.users.iter().map(|u| u.name.clone()).collect();
+    #[cfg(feature = "plot")]
+    let figures = experiments::draw_all(
+        &rows,
+        &selection.grid.methods,
+        &user_names,
+        example.as_ref().ok(),
+        out,
+    )?;
+    #[cfg(not(feature = "plot"))]
+    let figures = Vec::new();
+    let report_text = report::render(&report::ReportInput {
+        rows: &rows,
+        methods: &selection.grid.methods,
+        users: &user_names,
+        example: example.as_ref().map_err(Clone::clone),
+        figures: &figures,
+        manifest: &manifest,
+    });
+    let report = out.join("REPORT.md");
+    write(&report, &report_text)?;
+    Ok(Outcome {
+        report,
+        runs: rows.len(),
+        wall_s,
+    })
+}
+
+fn write(path: &Path, text: &str) -> Result<(), EvalError> {
+    std::fs::write(path, text).map_err(|source| EvalError::Io {
+        action: "write",
+        path: path.to_owned(),
+        source,
+    })
+}
