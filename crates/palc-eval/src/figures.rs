@@ -106,7 +106,7 @@ impl Figure for Bars {
             .flat_map(|(_, values)| values.iter().flatten())
             .fold(0.0f64, |a, &b| a.max(b));
         let top = if top > 0.0 { top * 1.15 } else { 1.0 };
-        let (plot, legend_area) = with_legend_area(root, &self.title)?;
+        let [plot, legend_area] = with_legend_area(root, &self.title)?;
         let mut chart = ChartBuilder::on(&plot)
             .margin(12)
             .x_label_area_size(45)
@@ -185,7 +185,7 @@ impl Figure for Lines {
             (0.0, if top > 0.0 { top * 1.15 } else { 1.0 })
         });
         let pad = (x1 - x0) * 0.03;
-        let (plot, legend_area) = with_legend_area(root, &self.title)?;
+        let [plot, legend_area] = with_legend_area(root, &self.title)?;
         let y_value = |y: f64| if self.log_y { y.log10() } else { y };
         let (y0, y1) = if self.log_y {
             let positive = || points().map(|p| p.1).filter(|&y| y > 0.0);
@@ -222,8 +222,10 @@ impl Figure for Lines {
         };
         let decades = (y1 - y0).round().max(1.0) as usize;
         let mut mesh = chart.configure_mesh();
+        let x_label = |x: &f64| format!("{x}");
         mesh.x_desc(&self.x_desc)
             .y_desc(&self.y_desc)
+            .x_label_formatter(&x_label)
             .y_label_formatter(&y_label)
             .label_style((FONT, 14))
             .axis_desc_style((FONT, 16));
@@ -260,10 +262,11 @@ const LEGEND_WIDTH_PERCENT: u32 = 22;
 fn with_legend_area<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     title: &str,
-) -> Result<(DrawingArea<DB, Shift>, DrawingArea<DB, Shift>), String> {
+) -> Result<[DrawingArea<DB, Shift>; 2], String> {
     let titled = root.titled(title, (FONT, 22)).map_err(plot_error)?;
     let width = titled.dim_in_pixel().0;
-    Ok(titled.split_horizontally(width * (100 - LEGEND_WIDTH_PERCENT) / 100))
+    let (plot, legend) = titled.split_horizontally(width * (100 - LEGEND_WIDTH_PERCENT) / 100);
+    Ok([plot, legend])
 }
 
 /// How a legend entry shows its series.

@@ -111,7 +111,6 @@ pub struct RunPlan {
 
 impl RunPlan {
     /// Every run, phase one first.
-    #[cfg(test)]
     pub fn all(&self) -> impl Iterator<Item = &RunSpec> {
         self.first.iter().chain(&self.transfer)
     }
@@ -119,6 +118,11 @@ impl RunPlan {
     /// Number of runs.
     pub fn len(&self) -> usize {
         self.first.len() + self.transfer.len()
+    }
+
+    /// Whether there is no run.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
     }
 }
 

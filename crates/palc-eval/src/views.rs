@@ -38,7 +38,7 @@ pub fn with_transfer<'a>(rows: &'a [RunRow], method: Method, user: &str) -> Vec<
 }
 
 /// The timing rows of one method.
-pub fn timing<'a>(rows: &'a [RunRow], method: Method) -> Vec<&'a RunRow> {
+pub fn timing(rows: &[RunRow], method: Method) -> Vec<&RunRow> {
     rows.iter()
         .filter(|r| r.spec.experiment == Experiment::Timing && r.spec.method == method)
         .collect()
