@@ -349,9 +349,148 @@ pub fn final_rates(rows: &[&RunRow]) -> (Option<f64>, Option<f64>) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::config::UserKind;
+    use crate::plan::RunSpec;
     use crate::results::Status;
     use crate::runner::tests::synthetic_rows;
     use palc_harness::Method;
+    use palc_traffic::SpeedCaseConfig;
+
+    /// A grid row built by hand: personalized after `takeovers`, or capped at 30
+    /// when `takeovers` is `None`.
+    fn row(
+        style: &str,
+        case: (&str, f64, f64),
+        headway_m: f64,
+        takeovers: Option<usize>,
+    ) -> RunRow {
+        let spec = RunSpec {
+            id: 0,
+            experiment: Experiment::Grid,
+            method: Method::Palc,
+            user: UserKind::deterministic(),
+            style: style.to_owned(),
+            speed_case: SpeedCaseConfig {
+                name: case.0.to_owned(),
+                ego_mph: case.1,
+                others_mph: case.2,
+            },
+            headway_m,
+            seed: 1,
+            dt: None,
+            horizon_margin_s: None,
+            experience_from: None,
+        };
+        let status = match takeovers {
+            Some(_) => Status::Personalized,
+            None => Status::CapReached,
+        };
+        let mut row = RunRow::without_result(spec, status, 30, 0.0);
+        row.takeovers = takeovers.unwrap_or(30);
+        row
+    }
+
+    const HIGH: (&str, f64, f64) = ("high", 45.0, 40.0);
+    const SLOW: (&str, f64, f64) = ("slow", 45.0, 35.0);
+
+    #[test]
+    fn trends_compare_hand_computed_means() {
+        let rows = [
+            row("aggressive", SLOW, 50.0, Some(2)),
+            row("aggressive", HIGH, 30.0, Some(4)),
+            row("cautious", SLOW, 50.0, Some(3)),
+            row("cautious", HIGH, 30.0, None),
+        ];
+        let refs: Vec<&RunRow> = rows.iter().collect();
+        // Aggressive (2 + 4) / 2 = 3, cautious (3 + 30) / 2 = 16.5.
+        let style = style_trend(&refs);
+        assert_eq!(style.first, ("aggressive".to_owned(), Some(3.0)));
+        assert_eq!(style.second, ("cautious".to_owned(), Some(16.5)));
+        assert_eq!(style.agrees(), Some(true));
+        // Slower others (35 mph): (2 + 3) / 2 = 2.5; faster (40 mph): (4 + 30) / 2 = 17.
+        let speed = traffic_speed_trend(&refs);
+        assert_eq!((speed.first.1, speed.second.1), (Some(2.5), Some(17.0)));
+        // Widest headway 50 m: 2.5; narrowest 30 m: 17.
+        let congestion = congestion_trend(&refs);
+        assert_eq!(congestion.first, ("50 m".to_owned(), Some(2.5)));
+        assert_eq!(congestion.second, ("30 m".to_owned(), Some(17.0)));
+        // Reversed when the narrow headway needs fewer.
+        let reversed = [
+            row("neutral", HIGH, 50.0, Some(5)),
+            row("neutral", HIGH, 30.0, Some(3)),
+        ];
+        let refs: Vec<&RunRow> = reversed.iter().collect();
+        assert_eq!(congestion_trend(&refs).agrees(), Some(false));
+        // One speed per ego speed: no slower or faster case to compare.
+        assert_eq!(traffic_speed_trend(&refs).agrees(), None);
+    }
+
+    #[test]
+    fn the_transfer_reduction_is_one_minus_the_ratio_of_paired_means() {
+        let mut grid = [
+            row("neutral", HIGH, 40.0, Some(4)),
+            row("neutral", SLOW, 40.0, None),
+            row("cautious", HIGH, 40.0, Some(6)),
+        ];
+        let mut transfer = [
+            row("neutral", HIGH, 40.0, Some(2)),
+            row("neutral", SLOW, 40.0, Some(5)),
+            row("cautious", HIGH, 40.0, Some(6)),
+        ];
+        for (i, r) in transfer.iter_mut().enumerate() {
+            r.spec.experiment = Experiment::Transfer;
+            r.spec.id = 10 + i;
+        }
+        // The third transfer run is refused: it and its grid run leave the pairs.
+        transfer[2].status = Status::Refused {
+            reason: "no experience".into(),
+        };
+        grid[2].spec.id = 2;
+        let rows: Vec<&RunRow> = grid.iter().chain(&transfer).collect();
+        let t = super::transfer(&rows);
+        // Without: (4 + 30) / 2 = 17; with: (2 + 5) / 2 = 3.5; 1 - 3.5 / 17.
+        assert_eq!(t.pairs, 2);
+        assert_eq!((t.without, t.with), (Some(17.0), Some(3.5)));
+        assert!((t.reduction.unwrap() - (1.0 - 3.5 / 17.0)).abs() < 1e-12);
+        assert_eq!(t.personalized, (1, 2));
+        assert_eq!(t.refused, 1);
+    }
+
+    #[test]
+    fn the_final_rate_is_compared_with_the_ceiling_over_counted_runs() {
+        let mut rows = [
+            row("neutral", HIGH, 40.0, Some(3)),
+            row("neutral", SLOW, 40.0, None),
+            row("neutral", SLOW, 30.0, None),
+        ];
+        rows[0].final_takeover_rate = Some(0.2);
+        rows[0].ceiling_takeover_rate = Some(0.1);
+        rows[1].final_takeover_rate = Some(0.4);
+        rows[1].ceiling_takeover_rate = Some(0.3);
+        // A refused run's rates, were there any, would not count.
+        rows[2].status = Status::Refused { reason: "x".into() };
+        rows[2].final_takeover_rate = Some(1.0);
+        rows[2].ceiling_takeover_rate = Some(1.0);
+        let refs: Vec<&RunRow> = rows.iter().collect();
+        let (rate, ceiling) = final_rates(&refs);
+        assert!((rate.unwrap() - 0.3).abs() < 1e-12);
+        assert!((ceiling.unwrap() - 0.2).abs() < 1e-12);
+        assert_eq!(final_rates(&[]), (None, None));
+    }
+
+    #[test]
+    fn the_mean_of_a_mixed_set_counts_failures_at_the_cap() {
+        let rows = [
+            row("neutral", HIGH, 40.0, Some(2)),
+            row("neutral", HIGH, 35.0, Some(3)),
+            row("neutral", HIGH, 30.0, None),
+        ];
+        let summary = Summary::of(&rows);
+        // (2 + 3 + 30) / 3, median 3.
+        assert!((summary.mean.unwrap() - 35.0 / 3.0).abs() < 1e-12);
+        assert_eq!(summary.median, Some(3.0));
+        assert_eq!(summary.personalized, 2);
+    }
 
     #[test]
     fn failures_count_at_the_cap_and_refusals_apart() {
