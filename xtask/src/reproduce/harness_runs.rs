@@ -55,7 +55,7 @@ impl HarnessRuns {
             seed: spec.seed,
         };
         config.user = UserConfig {
-            style: spec.style.clone(),
+            style: spec.style.parse()?,
             custom: None,
             spread: spec.user.spread_relative.map(|relative| Spread {
                 relative,
@@ -139,7 +139,7 @@ fn row(spec: &RunSpec, result: &RunResult, cap: usize, wall_s: f64) -> RunRow {
             Outcome::Personalized => Status::Personalized,
             Outcome::CapReached => Status::CapReached,
         },
-        takeovers: summary.takeovers,
+        takeovers: summary.counted_takeovers(),
         cap,
         lane_changes: summary.lane_changes,
         final_max_deviation_m: Some(summary.final_max_deviation_m),
@@ -153,18 +153,11 @@ fn row(spec: &RunSpec, result: &RunResult, cap: usize, wall_s: f64) -> RunRow {
 }
 
 fn iteration(record: &LaneChangeRecord) -> Iteration {
-    let t = &record.times;
     Iteration {
         takeover: record.takeover.is_some(),
         perceived_safety_ratio: record.perceived_safety_ratio,
         max_deviation_m: record.max_deviation_m,
-        times_s: [
-            t.zone_fit_s,
-            t.bounds_s,
-            t.expert_s,
-            t.correction_s,
-            t.plan_s,
-        ],
+        times_s: record.times.parts(),
     }
 }
 
@@ -219,7 +212,7 @@ impl ExampleTrace {
                 .iter()
                 .map(|s| s.to_string())
                 .collect(),
-            takeovers: result.summary.takeovers,
+            takeovers: result.summary.counted_takeovers(),
             personalized: result.summary.outcome == Outcome::Personalized,
         }
     }
