@@ -16,7 +16,7 @@ use crate::HarnessError;
 use crate::config::{LearnConfig, StoppingConfig};
 use crate::drive::{Drive, execute, problem};
 use crate::learn::{RunResult, aggregator_options, prepare};
-use crate::lesson::{lesson, scenes};
+use crate::lesson::{lesson, scenes, zone_feature_set};
 use crate::method::Method;
 use crate::observer::{LessonEvent, Observer};
 use crate::record::{LaneChangeRecord, Outcome, RunSummary};
@@ -289,7 +289,8 @@ impl LearningLoop {
         takeover_step: usize,
         observer: &mut dyn Observer,
     ) -> Result<(), HarnessError> {
-        let feature_set = palc_zone_filter::FeatureSet::default();
+        // The samples update the zone, so they take its features (Eq. 1 or a variant).
+        let feature_set = zone_feature_set(&self.experience, &self.options);
         let lesson = lesson(self.method, &self.setup, drive, takeover_step, feature_set)?;
         let result: Result<StepOutcome, AggregatorError> = learn_from_lesson(
             &mut self.planner,

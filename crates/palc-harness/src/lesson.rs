@@ -3,7 +3,7 @@
 //! model's own features (Eq. 1 or a variant), and the zone filter's view of each
 //! planning step.
 
-use palc_aggregator::Lesson;
+use palc_aggregator::{AggregatorOptions, Experience, Lesson};
 use palc_planner::State;
 use palc_zone_filter::{FeatureInput, FeatureSet, Label, Sample, StepScene, features};
 
@@ -11,6 +11,16 @@ use crate::HarnessError;
 use crate::drive::Drive;
 use crate::method::{Driver, Method, label};
 use crate::setup::Setup;
+
+/// The feature set of the zone the lesson's samples will update: the experience's
+/// zone when it has one (the aggregator updates that one), else the zone the
+/// options would create.
+pub(crate) fn zone_feature_set(experience: &Experience, options: &AggregatorOptions) -> FeatureSet {
+    experience
+        .zone
+        .as_ref()
+        .map_or(options.zone.feature_set, |zone| zone.config().feature_set)
+}
 
 /// Turns a taken-over lane change into a lesson, labelled by the method's rule,
 /// with samples in the zone's `feature_set`.
