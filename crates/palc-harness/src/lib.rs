@@ -7,6 +7,16 @@
 //! [`palc_zone_filter`]) learns from the lesson. Two methods run side by side
 //! ([`Method`]): the paper's, with only its equation errors corrected, and palc's.
 //!
+//! The loop is an executor, [`LearningLoop`]: `new` prepares a scenario, `step`
+//! drives one lane change and learns from a takeover, `termination` applies the
+//! stopping rules and `run` steps until they end the run; [`run`] is its one-call
+//! form. An [`Observer`] sees every lane change, every lesson as a [`LessonEvent`]
+//! (what the aggregator produced, or why it could not learn) and the
+//! [`RunSummary`], whose [`RunSummary::counted_takeovers`] is the paper's count.
+//! Configs are built from TOML or from a base with [`LearnConfig::with_cell`],
+//! [`LearnConfig::with_user`] and [`LearnConfig::with_method`]; users are
+//! [`StylePreset`]s or custom styles.
+//!
 //! ```no_run
 //! use palc_harness::{LearnConfig, NoObserver, run};
 //!
