@@ -11,29 +11,42 @@ use crate::{
     project_convex,
 };
 
-/// Wall time of each part of one step (s).
+/// Wall time of each part of one learning step (s): the project's one breakdown of
+/// a step's compute time (paper Fig. 13), used by the harness's records and the
+/// evaluation's reports alike.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct Timings {
     /// Adding the lesson's samples to the zone model (0 without the zone).
-    pub zone_fit_seconds: f64,
-    /// Projecting the zone onto lateral bounds (0 without the zone).
-    pub bounds_seconds: f64,
+    pub zone_fit_s: f64,
+    /// Projecting the zone onto lateral bounds, Eqs. (27)-(32) (0 without the zone).
+    pub bounds_s: f64,
     /// Building and planning the expert trajectory.
-    pub expert_seconds: f64,
+    pub expert_s: f64,
     /// The correction rule, including its inner plans.
-    pub correction_seconds: f64,
+    pub correction_s: f64,
     /// The new plan with the corrected weights.
-    pub plan_seconds: f64,
+    pub plan_s: f64,
 }
 
 impl Timings {
-    /// Sum of the parts.
-    pub fn total_seconds(&self) -> f64 {
-        self.zone_fit_seconds
-            + self.bounds_seconds
-            + self.expert_seconds
-            + self.correction_seconds
-            + self.plan_seconds
+    /// Names of the parts, in the order of [`Timings::parts`].
+    pub const PART_NAMES: [&'static str; 5] =
+        ["zone fit", "bounds", "expert", "correction", "plan"];
+
+    /// The parts in the order of [`Timings::PART_NAMES`] (s).
+    pub fn parts(&self) -> [f64; 5] {
+        [
+            self.zone_fit_s,
+            self.bounds_s,
+            self.expert_s,
+            self.correction_s,
+            self.plan_s,
+        ]
+    }
+
+    /// Sum of the parts (s).
+    pub fn total_s(&self) -> f64 {
+        self.parts().iter().sum()
     }
 }
 
@@ -136,7 +149,7 @@ pub fn learn_from_lesson(
     } else {
         experience.zone.clone()
     };
-    timings.zone_fit_seconds = start.elapsed().as_secs_f64();
+    timings.zone_fit_s = start.elapsed().as_secs_f64();
 
     let start = Instant::now();
     let bounds = match (&zone, options.use_zone) {
@@ -144,7 +157,7 @@ pub fn learn_from_lesson(
         _ => None,
     };
     let plan_problem = with_bounds(template, weights.clone(), bounds.as_deref())?;
-    timings.bounds_seconds = start.elapsed().as_secs_f64();
+    timings.bounds_s = start.elapsed().as_secs_f64();
 
     let start = Instant::now();
     let generator = options.expert.generator();
@@ -161,7 +174,7 @@ pub fn learn_from_lesson(
             expert: generator.name(),
             source,
         })?;
-    timings.expert_seconds = start.elapsed().as_secs_f64();
+    timings.expert_s = start.elapsed().as_secs_f64();
 
     let start = Instant::now();
     let state = experience
@@ -184,7 +197,7 @@ pub fn learn_from_lesson(
             candidate.weights = w.clone();
             planner.plan(&candidate)
         })?;
-    timings.correction_seconds = start.elapsed().as_secs_f64();
+    timings.correction_s = start.elapsed().as_secs_f64();
 
     let start = Instant::now();
     let problem = Problem {
@@ -192,7 +205,7 @@ pub fn learn_from_lesson(
         ..plan_problem
     };
     let plan = planner.plan(&problem)?;
-    timings.plan_seconds = start.elapsed().as_secs_f64();
+    timings.plan_s = start.elapsed().as_secs_f64();
 
     let mut metadata = experience.metadata.clone();
     metadata.lessons += 1;

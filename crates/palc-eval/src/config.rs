@@ -13,7 +13,7 @@
 
 use std::path::{Path, PathBuf};
 
-use palc_harness::Method;
+use palc_harness::{Method, StylePreset};
 use palc_traffic::{SpeedCaseConfig, TestbedConfig};
 use serde::{Deserialize, Serialize};
 
@@ -54,8 +54,8 @@ pub struct GridConfig {
     /// Adjacent headways (m); the test bed's by default.
     #[serde(default)]
     pub headways_m: Option<Vec<f64>>,
-    /// Style names.
-    pub styles: Vec<String>,
+    /// Driving styles.
+    pub styles: Vec<StylePreset>,
     /// Scene seeds (with spread, the user's draws use the same seed); the test
     /// bed's by default.
     #[serde(default)]
@@ -71,8 +71,8 @@ pub struct Grid {
     pub speed_cases: Vec<SpeedCaseConfig>,
     /// Adjacent headways (m).
     pub headways_m: Vec<f64>,
-    /// Style names.
-    pub styles: Vec<String>,
+    /// Driving styles.
+    pub styles: Vec<StylePreset>,
     /// Scene seeds.
     pub seeds: Vec<u64>,
 }
@@ -133,8 +133,8 @@ pub struct TimingConfig {
     pub dts: Vec<f64>,
     /// Horizon margins after the standard ALC's end (s).
     pub horizon_margins_s: Vec<f64>,
-    /// Styles.
-    pub styles: Vec<String>,
+    /// Driving styles.
+    pub styles: Vec<StylePreset>,
     /// Speed case of the timed runs.
     pub speed_case: String,
     /// Adjacent headway of the timed runs (m).
@@ -149,8 +149,8 @@ pub struct TimingConfig {
 pub struct ExampleConfig {
     /// Method.
     pub method: Method,
-    /// Style (the paper shows an aggressive user).
-    pub style: String,
+    /// Driving style (the paper shows an aggressive user).
+    pub style: StylePreset,
     /// Speed case.
     pub speed_case: String,
     /// Adjacent headway (m).

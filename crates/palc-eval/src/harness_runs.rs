@@ -1,14 +1,17 @@
 //! The one place that calls the harness: a [`RunSpec`] becomes a
-//! [`LearnConfig`] (the base config with the run's cell, user and method), and
-//! the harness's [`RunResult`] becomes a [`RunRow`].
+//! [`LearnConfig`] (the base config with the run's cell, user and method, set
+//! through its builders), and the run is watched by observers: [`RowRecorder`]
+//! keeps what every lane change and lesson produced for the run's [`RunRow`]
+//! (outcome, perceived safety, compute time by part, learning failures), and
+//! [`TraceRecorder`] keeps the trajectories of the qualitative example (Fig. 6).
 
 use std::time::Instant;
 
 use palc_aggregator::Experience;
 use palc_harness::user::Spread;
 use palc_harness::{
-    CellChoice, HarnessError, LaneChangeRecord, LearnConfig, NoObserver, Outcome, RunResult,
-    UserConfig,
+    CellChoice, HarnessError, LaneChangeRecord, LearnConfig, LessonEvent, Observer, Outcome,
+    RunResult, UserConfig,
 };
 use palc_traffic::TestbedConfig;
 use serde::Serialize;
@@ -43,23 +46,24 @@ impl HarnessRuns {
         &self.testbed
     }
 
-    /// The learning config of one run.
+    /// The learning config of one run: the base with the run's method, cell,
+    /// user and (timing experiment) step and horizon margin.
     pub fn config(&self, spec: &RunSpec) -> Result<LearnConfig, EvalError> {
-        let mut config = self.base.clone();
-        config.method = spec.method;
-        config.cell = CellChoice {
-            speed_case: spec.speed_case.name.clone(),
-            headway_m: spec.headway_m,
-            seed: spec.seed,
-        };
-        config.user = UserConfig {
-            style: spec.style.clone(),
-            custom: None,
+        let user = UserConfig {
             spread: spec.user.spread_relative.map(|relative| Spread {
                 relative,
                 seed: spec.seed,
             }),
+            ..UserConfig::preset(spec.style)
         };
+        let mut config = (self.base.clone())
+            .with_method(spec.method)
+            .with_cell(CellChoice {
+                speed_case: spec.speed_case.name.clone(),
+                headway_m: spec.headway_m,
+                seed: spec.seed,
+            })
+            .with_user(user);
         if let Some(dt) = spec.dt {
             config.planning.dt = dt;
         }
@@ -76,12 +80,13 @@ impl HarnessRuns {
     /// Runs the qualitative example and keeps every lane change.
     pub fn example(&self, spec: &RunSpec) -> Result<ExampleTrace, EvalError> {
         let config = self.config(spec)?;
+        let mut trace = TraceRecorder::default();
         let result =
-            palc_harness::run(&config, None, &mut NoObserver).map_err(|source| EvalError::Run {
+            palc_harness::run(&config, None, &mut trace).map_err(|source| EvalError::Run {
                 run: format!("the example {}", spec.label()),
                 source,
             })?;
-        Ok(ExampleTrace::from_result(&result))
+        Ok(ExampleTrace::new(&result, trace.lane_changes))
     }
 }
 
@@ -100,11 +105,12 @@ impl Executor for HarnessRuns {
                 return (RunRow::without_result(spec.clone(), status, cap, 0.0), None);
             }
         };
-        let result = palc_harness::run(&config, experience, &mut NoObserver);
+        let mut recorder = RowRecorder::default();
+        let result = palc_harness::run(&config, experience, &mut recorder);
         let wall_s = start.elapsed().as_secs_f64();
         match result {
             Ok(result) => {
-                let row = row(spec, &result, cap, wall_s);
+                let row = row(spec, &result, recorder.iterations, wall_s);
                 (row, Some(result.experience))
             }
             Err(HarnessError::Scenario { scenario, reason }) => {
@@ -133,7 +139,7 @@ impl Executor for HarnessRuns {
     }
 }
 
-fn row(spec: &RunSpec, result: &RunResult, cap: usize, wall_s: f64) -> RunRow {
+fn row(spec: &RunSpec, result: &RunResult, iterations: Vec<Iteration>, wall_s: f64) -> RunRow {
     let summary = &result.summary;
     RunRow {
         spec: spec.clone(),
@@ -141,8 +147,8 @@ fn row(spec: &RunSpec, result: &RunResult, cap: usize, wall_s: f64) -> RunRow {
             Outcome::Personalized => Status::Personalized,
             Outcome::CapReached => Status::CapReached,
         },
-        takeovers: summary.takeovers,
-        cap,
+        takeovers: summary.counted_takeovers(),
+        cap: summary.cap,
         lane_changes: summary.lane_changes,
         final_max_deviation_m: Some(summary.final_max_deviation_m),
         final_takeover_rate: Some(summary.final_takeover_rate),
@@ -150,24 +156,57 @@ fn row(spec: &RunSpec, result: &RunResult, cap: usize, wall_s: f64) -> RunRow {
         horizon: result.horizon,
         dt: Some(result.dt),
         wall_s,
-        iterations: result.records.iter().map(iteration).collect(),
+        iterations,
     }
 }
 
-fn iteration(record: &LaneChangeRecord) -> Iteration {
-    let t = &record.times;
-    Iteration {
-        takeover: record.takeover.is_some(),
-        perceived_safety_ratio: record.perceived_safety_ratio,
-        max_deviation_m: record.max_deviation_m,
-        times_s: [
-            t.zone_fit_s,
-            t.bounds_s,
-            t.expert_s,
-            t.correction_s,
-            t.plan_s,
-        ],
-        learning_error: record.learning_error.clone(),
+/// Keeps, per lane change, what a [`RunRow`] reports: takeover, perceived
+/// safety, deviation, compute time by part and, from the lesson events, why a
+/// lesson could not be learned.
+#[derive(Debug, Default)]
+pub struct RowRecorder {
+    /// One entry per lane change, in order.
+    pub iterations: Vec<Iteration>,
+}
+
+impl Observer for RowRecorder {
+    fn lane_change(&mut self, record: &LaneChangeRecord) {
+        self.iterations.push(Iteration {
+            takeover: record.takeover.is_some(),
+            perceived_safety_ratio: record.perceived_safety_ratio,
+            max_deviation_m: record.max_deviation_m,
+            times_s: record.times.parts(),
+            learning_error: None,
+        });
+    }
+
+    fn lesson(&mut self, event: &LessonEvent<'_>) {
+        if let LessonEvent::Failed {
+            lane_change, error, ..
+        } = event
+        {
+            if let Some(iteration) = self.iterations.get_mut(*lane_change) {
+                iteration.learning_error = Some(error.to_string());
+            }
+        }
+    }
+}
+
+/// Keeps the trajectories of every lane change (Fig. 6).
+#[derive(Debug, Default)]
+pub struct TraceRecorder {
+    /// One entry per lane change, in order.
+    pub lane_changes: Vec<ExampleLaneChange>,
+}
+
+impl Observer for TraceRecorder {
+    fn lane_change(&mut self, record: &LaneChangeRecord) {
+        self.lane_changes.push(ExampleLaneChange {
+            planned_l: record.planned_l.clone(),
+            expected_l: record.expected_l.clone(),
+            driven_l: record.driven_l.clone(),
+            takeover_step: record.takeover.map(|t| t.step),
+        });
     }
 }
 
@@ -205,24 +244,17 @@ pub struct ExampleLaneChange {
 }
 
 impl ExampleTrace {
-    fn from_result(result: &RunResult) -> ExampleTrace {
+    fn new(result: &RunResult, lane_changes: Vec<ExampleLaneChange>) -> ExampleTrace {
         ExampleTrace {
             label: format!("{} ({})", result.label, result.method.name()),
             dt: result.dt,
-            lane_changes: (result.records.iter())
-                .map(|r| ExampleLaneChange {
-                    planned_l: r.planned_l.clone(),
-                    expected_l: r.expected_l.clone(),
-                    driven_l: r.driven_l.clone(),
-                    takeover_step: r.takeover.map(|t| t.step),
-                })
-                .collect(),
+            lane_changes,
             weights: result.experience.weights.columns().to_vec(),
             weight_names: palc_planner::feature::NAMES
                 .iter()
                 .map(|s| s.to_string())
                 .collect(),
-            takeovers: result.summary.takeovers,
+            takeovers: result.summary.counted_takeovers(),
             personalized: result.summary.outcome == Outcome::Personalized,
         }
     }

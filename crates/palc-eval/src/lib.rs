@@ -166,7 +166,7 @@ impl Evaluation {
             experiment: Experiment::Grid,
             method: example.method,
             user: config::UserKind::deterministic(),
-            style: example.style.clone(),
+            style: example.style,
             speed_case,
             headway_m: example.headway_m,
             seed: example.seed,

@@ -3,7 +3,7 @@
 //! The order of the list is the order of every output, whatever the number of
 //! threads: runs are executed in parallel but collected by index.
 
-use palc_harness::Method;
+use palc_harness::{Method, StylePreset};
 use palc_traffic::{SpeedCaseConfig, TestbedConfig};
 use serde::{Deserialize, Serialize};
 
@@ -45,7 +45,7 @@ pub struct RunSpec {
     /// The user kind.
     pub user: UserKind,
     /// Style name.
-    pub style: String,
+    pub style: StylePreset,
     /// Speed case, with its speeds.
     pub speed_case: SpeedCaseConfig,
     /// Adjacent headway (m).
@@ -70,7 +70,7 @@ impl RunSpec {
         (
             self.method.name(),
             self.user.name.clone(),
-            self.style.clone(),
+            self.style.name().to_owned(),
             self.speed_case.name.clone(),
             self.headway_m.to_bits(),
             self.seed,
@@ -141,7 +141,7 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
                                 experiment: Experiment::Grid,
                                 method: *method,
                                 user: user.clone(),
-                                style: style.clone(),
+                                style: *style,
                                 speed_case: case.clone(),
                                 headway_m,
                                 seed,
@@ -167,7 +167,7 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
                         experiment: Experiment::Timing,
                         method: *method,
                         user: deterministic.clone(),
-                        style: style.clone(),
+                        style: *style,
                         speed_case: timing_case.clone(),
                         headway_m: timing.headway_m,
                         seed: timing.seed,
@@ -269,7 +269,7 @@ pub(crate) mod tests {
                 methods: vec![Method::Paper, Method::Palc],
                 speed_cases: vec![case("collector-high"), case("arterial-slow")],
                 headways_m: vec![50.0, 30.0],
-                styles: vec!["aggressive".into(), "neutral".into(), "cautious".into()],
+                styles: StylePreset::ALL.to_vec(),
                 seeds: vec![1, 2],
             },
             users: vec![
@@ -287,14 +287,14 @@ pub(crate) mod tests {
                 methods: vec![Method::Palc],
                 dts: vec![0.1, 0.05],
                 horizon_margins_s: vec![0.0, 1.0],
-                styles: vec!["neutral".into()],
+                styles: vec![StylePreset::Neutral],
                 speed_case: "collector-high".into(),
                 headway_m: 40.0,
                 seed: 1,
             },
             example: ExampleConfig {
                 method: Method::Palc,
-                style: "aggressive".into(),
+                style: StylePreset::Aggressive,
                 speed_case: "collector-high".into(),
                 headway_m: 40.0,
                 seed: 1,

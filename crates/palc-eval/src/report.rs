@@ -159,7 +159,7 @@ fn user_section(out: &mut String, input: &ReportInput, user: &str) {
     for (title, key) in [
         (
             "By style",
-            &(|r: &RunRow| r.spec.style.clone()) as &dyn Fn(&RunRow) -> String,
+            &(|r: &RunRow| r.spec.style.name().to_owned()) as &dyn Fn(&RunRow) -> String,
         ),
         ("By speed case", &speed_label),
         ("By adjacent headway (m)", &|r: &RunRow| {

@@ -63,7 +63,7 @@ pub struct Iteration {
 }
 
 /// Names of the parts of [`Iteration::times_s`].
-pub const PART_NAMES: [&str; 5] = ["zone fit", "bounds", "expert", "correction", "plan"];
+pub const PART_NAMES: [&str; 5] = palc_harness::Timings::PART_NAMES;
 
 impl Iteration {
     /// Total compute time of the iteration (s).
@@ -123,10 +123,11 @@ impl RunRow {
 
     /// Takeovers as every statistic counts them: a failure counts at the cap.
     pub fn counted_takeovers(&self) -> usize {
-        match self.status {
-            Status::Personalized => self.takeovers,
-            _ => self.cap.max(self.takeovers),
-        }
+        let outcome = match self.status {
+            Status::Personalized => palc_harness::Outcome::Personalized,
+            _ => palc_harness::Outcome::CapReached,
+        };
+        outcome.counted_takeovers(self.takeovers, self.cap)
     }
 
     /// Whether the run personalized.
@@ -201,7 +202,7 @@ pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> Result<(), EvalEr
             experiment: row.spec.experiment.name(),
             method: row.spec.method.name(),
             user: &row.spec.user.name,
-            style: &row.spec.style,
+            style: row.spec.style.name(),
             speed_case: &row.spec.speed_case.name,
             ego_mph: row.spec.speed_case.ego_mph,
             others_mph: row.spec.speed_case.others_mph,

@@ -130,7 +130,7 @@ pub(crate) mod tests {
     use super::*;
     use crate::plan::{self, Experiment};
     use crate::results::Iteration;
-    use palc_harness::Method;
+    use palc_harness::{Method, StylePreset};
 
     /// A deterministic stand-in for the harness: the outcome is a function of
     /// the spec (and of whether experience was given), never of the thread.
@@ -140,10 +140,10 @@ pub(crate) mod tests {
         type Experience = usize;
 
         fn run(&self, spec: &RunSpec, experience: Option<&usize>) -> (RunRow, Option<usize>) {
-            let style = match spec.style.as_str() {
-                "aggressive" => 2,
-                "neutral" => 4,
-                _ => 6,
+            let style = match spec.style {
+                StylePreset::Aggressive => 2,
+                StylePreset::Neutral => 4,
+                StylePreset::Cautious => 6,
             };
             let base = style + (spec.seed as usize % 3) + (spec.headway_m < 40.0) as usize;
             let takeovers = if spec.method == Method::Paper {
@@ -155,23 +155,24 @@ pub(crate) mod tests {
                 Some(_) => takeovers * 3 / 4,
                 None => takeovers,
             };
-            let status = if spec.speed_case.name == "arterial-slow" && spec.style == "cautious" {
-                return (
-                    RunRow::without_result(
-                        spec.clone(),
-                        Status::Refused {
-                            reason: "the standard ALC is not conservative".into(),
-                        },
-                        30,
-                        0.0,
-                    ),
-                    None,
-                );
-            } else if takeovers >= 30 {
-                Status::CapReached
-            } else {
-                Status::Personalized
-            };
+            let status =
+                if spec.speed_case.name == "arterial-slow" && spec.style == StylePreset::Cautious {
+                    return (
+                        RunRow::without_result(
+                            spec.clone(),
+                            Status::Refused {
+                                reason: "the standard ALC is not conservative".into(),
+                            },
+                            30,
+                            0.0,
+                        ),
+                        None,
+                    );
+                } else if takeovers >= 30 {
+                    Status::CapReached
+                } else {
+                    Status::Personalized
+                };
             let lane_changes = takeovers + 3;
             let iterations = (0..lane_changes)
                 .map(|i| Iteration {

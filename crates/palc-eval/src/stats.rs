@@ -4,6 +4,7 @@
 
 use std::collections::HashMap;
 
+use palc_harness::StylePreset;
 use serde::Serialize;
 
 use crate::plan::{CellKey, Experiment};
@@ -279,12 +280,12 @@ fn mean_where(rows: &[&RunRow], keep: impl Fn(&RunRow) -> bool) -> Option<f64> {
 pub fn style_trend(rows: &[&RunRow]) -> Trend {
     Trend {
         first: (
-            "aggressive".into(),
-            mean_where(rows, |r| r.spec.style == "aggressive"),
+            StylePreset::Aggressive.name().into(),
+            mean_where(rows, |r| r.spec.style == StylePreset::Aggressive),
         ),
         second: (
-            "cautious".into(),
-            mean_where(rows, |r| r.spec.style == "cautious"),
+            StylePreset::Cautious.name().into(),
+            mean_where(rows, |r| r.spec.style == StylePreset::Cautious),
         ),
     }
 }
@@ -359,7 +360,7 @@ mod tests {
     /// A grid row built by hand: personalized after `takeovers`, or capped at 30
     /// when `takeovers` is `None`.
     fn row(
-        style: &str,
+        style: StylePreset,
         case: (&str, f64, f64),
         headway_m: f64,
         takeovers: Option<usize>,
@@ -369,7 +370,7 @@ mod tests {
             experiment: Experiment::Grid,
             method: Method::Palc,
             user: UserKind::deterministic(),
-            style: style.to_owned(),
+            style,
             speed_case: SpeedCaseConfig {
                 name: case.0.to_owned(),
                 ego_mph: case.1,
@@ -396,10 +397,10 @@ mod tests {
     #[test]
     fn trends_compare_hand_computed_means() {
         let rows = [
-            row("aggressive", SLOW, 50.0, Some(2)),
-            row("aggressive", HIGH, 30.0, Some(4)),
-            row("cautious", SLOW, 50.0, Some(3)),
-            row("cautious", HIGH, 30.0, None),
+            row(StylePreset::Aggressive, SLOW, 50.0, Some(2)),
+            row(StylePreset::Aggressive, HIGH, 30.0, Some(4)),
+            row(StylePreset::Cautious, SLOW, 50.0, Some(3)),
+            row(StylePreset::Cautious, HIGH, 30.0, None),
         ];
         let refs: Vec<&RunRow> = rows.iter().collect();
         // Aggressive (2 + 4) / 2 = 3, cautious (3 + 30) / 2 = 16.5.
@@ -416,8 +417,8 @@ mod tests {
         assert_eq!(congestion.second, ("30 m".to_owned(), Some(17.0)));
         // Reversed when the narrow headway needs fewer.
         let reversed = [
-            row("neutral", HIGH, 50.0, Some(5)),
-            row("neutral", HIGH, 30.0, Some(3)),
+            row(StylePreset::Neutral, HIGH, 50.0, Some(5)),
+            row(StylePreset::Neutral, HIGH, 30.0, Some(3)),
         ];
         let refs: Vec<&RunRow> = reversed.iter().collect();
         assert_eq!(congestion_trend(&refs).agrees(), Some(false));
@@ -428,14 +429,14 @@ mod tests {
     #[test]
     fn the_transfer_reduction_is_one_minus_the_ratio_of_paired_means() {
         let mut grid = [
-            row("neutral", HIGH, 40.0, Some(4)),
-            row("neutral", SLOW, 40.0, None),
-            row("cautious", HIGH, 40.0, Some(6)),
+            row(StylePreset::Neutral, HIGH, 40.0, Some(4)),
+            row(StylePreset::Neutral, SLOW, 40.0, None),
+            row(StylePreset::Cautious, HIGH, 40.0, Some(6)),
         ];
         let mut transfer = [
-            row("neutral", HIGH, 40.0, Some(2)),
-            row("neutral", SLOW, 40.0, Some(5)),
-            row("cautious", HIGH, 40.0, Some(6)),
+            row(StylePreset::Neutral, HIGH, 40.0, Some(2)),
+            row(StylePreset::Neutral, SLOW, 40.0, Some(5)),
+            row(StylePreset::Cautious, HIGH, 40.0, Some(6)),
         ];
         for (i, r) in transfer.iter_mut().enumerate() {
             r.spec.experiment = Experiment::Transfer;
@@ -459,9 +460,9 @@ mod tests {
     #[test]
     fn the_final_rate_is_compared_with_the_ceiling_over_counted_runs() {
         let mut rows = [
-            row("neutral", HIGH, 40.0, Some(3)),
-            row("neutral", SLOW, 40.0, None),
-            row("neutral", SLOW, 30.0, None),
+            row(StylePreset::Neutral, HIGH, 40.0, Some(3)),
+            row(StylePreset::Neutral, SLOW, 40.0, None),
+            row(StylePreset::Neutral, SLOW, 30.0, None),
         ];
         rows[0].final_takeover_rate = Some(0.2);
         rows[0].ceiling_takeover_rate = Some(0.1);
@@ -481,9 +482,9 @@ mod tests {
     #[test]
     fn the_mean_of_a_mixed_set_counts_failures_at_the_cap() {
         let rows = [
-            row("neutral", HIGH, 40.0, Some(2)),
-            row("neutral", HIGH, 35.0, Some(3)),
-            row("neutral", HIGH, 30.0, None),
+            row(StylePreset::Neutral, HIGH, 40.0, Some(2)),
+            row(StylePreset::Neutral, HIGH, 35.0, Some(3)),
+            row(StylePreset::Neutral, HIGH, 30.0, None),
         ];
         let summary = Summary::of(&rows);
         // (2 + 3 + 30) / 3, median 3.
@@ -550,7 +551,7 @@ mod tests {
         let safety = safety(&refs);
         assert_eq!(safety.personalized_at_one, safety.personalized);
         assert!(safety.mean_by_iteration[0].0 < 1.0);
-        let groups = by(&refs, |r| r.spec.style.clone());
+        let groups = by(&refs, |r| r.spec.style);
         assert_eq!(groups.len(), 3);
         assert!(groups[0].1.mean < groups[2].1.mean);
     }

@@ -11,7 +11,7 @@ use std::path::{Path, PathBuf};
 use palc_eval::config::{Selection, TimingConfig, TransferConfig, TransferSource};
 use palc_eval::stats::Summary;
 use palc_eval::{Evaluation, Experiment, NoProgress, RunRow, plan, runner};
-use palc_harness::Method;
+use palc_harness::{Method, StylePreset};
 use serde::{Deserialize, Serialize};
 
 /// The key numbers of one run, rounded so that the file is readable.
@@ -49,7 +49,7 @@ fn subset(evaluation: &Evaluation) -> Selection {
         .cloned()
         .collect();
     selection.grid.headways_m = vec![40.0];
-    selection.grid.styles = vec!["aggressive".into(), "cautious".into()];
+    selection.grid.styles = vec![StylePreset::Aggressive, StylePreset::Cautious];
     selection.grid.seeds = vec![1];
     selection.users.retain(|u| u.spread_relative.is_none());
     selection.transfer = TransferConfig {

@@ -8,7 +8,7 @@ use crate::HarnessError;
 use crate::method::Method;
 use crate::setup::PlanningConfig;
 use crate::standard_alc::StandardWeights;
-use crate::user::{Spread, Style};
+use crate::user::{Spread, Style, StylePreset};
 
 /// Everything that describes one run of the lesson-learning loop.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -58,7 +58,7 @@ pub struct CellChoice {
 #[serde(deny_unknown_fields)]
 pub struct UserConfig {
     /// `aggressive`, `neutral`, `cautious` or `custom`.
-    pub style: String,
+    pub style: UserStyle,
     /// The style when `style = "custom"`.
     #[serde(default)]
     pub custom: Option<Style>,
@@ -68,20 +68,100 @@ pub struct UserConfig {
 }
 
 impl UserConfig {
+    /// A deterministic user of one of the paper's styles.
+    pub fn preset(preset: StylePreset) -> UserConfig {
+        UserConfig {
+            style: UserStyle::Preset(preset),
+            custom: None,
+            spread: None,
+        }
+    }
+
     /// The nominal style of this user.
+    ///
+    /// # Errors
+    /// [`HarnessError::InvalidConfig`] for `custom` without a valid `[user.custom]` table.
     pub fn style(&self) -> Result<Style, HarnessError> {
-        match (self.style.as_str(), self.custom) {
-            ("custom", Some(style)) => {
+        match (self.style, self.custom) {
+            (UserStyle::Preset(preset), _) => Ok(preset.style()),
+            (UserStyle::Custom, Some(style)) => {
                 style.validate("user.custom")?;
                 Ok(style)
             }
-            ("custom", None) => Err(HarnessError::InvalidConfig {
+            (UserStyle::Custom, None) => Err(HarnessError::InvalidConfig {
                 field: "user.custom".to_owned(),
                 value: f64::NAN,
                 bound: "a [user.custom] table when style = \"custom\"".to_owned(),
             }),
-            (name, _) => Style::named(name),
         }
+    }
+}
+
+/// The style a [`UserConfig`] names: one of the paper's presets, or `custom` for
+/// the `[user.custom]` table.
+///
+/// Reads and writes as a name (`style = "neutral"`, `style = "custom"`); any other
+/// name is refused when the config is parsed, with the list of valid names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub enum UserStyle {
+    /// One of the paper's three styles.
+    Preset(StylePreset),
+    /// The style of `[user.custom]`.
+    Custom,
+}
+
+impl UserStyle {
+    /// The name in configs and reports.
+    pub const fn name(self) -> &'static str {
+        match self {
+            UserStyle::Preset(preset) => preset.name(),
+            UserStyle::Custom => "custom",
+        }
+    }
+}
+
+impl From<StylePreset> for UserStyle {
+    fn from(preset: StylePreset) -> Self {
+        UserStyle::Preset(preset)
+    }
+}
+
+impl std::str::FromStr for UserStyle {
+    type Err = HarnessError;
+
+    /// A preset's name or `custom`; [`HarnessError::UnknownStyle`] lists the valid names.
+    fn from_str(name: &str) -> Result<Self, Self::Err> {
+        match name {
+            "custom" => Ok(UserStyle::Custom),
+            _ => name
+                .parse::<StylePreset>()
+                .map(UserStyle::Preset)
+                .map_err(|_| HarnessError::UnknownStyle {
+                    name: name.to_owned(),
+                    expected: format!("{}, `custom`", StylePreset::quoted_names()),
+                }),
+        }
+    }
+}
+
+impl TryFrom<String> for UserStyle {
+    type Error = HarnessError;
+
+    fn try_from(name: String) -> Result<Self, Self::Error> {
+        name.parse()
+    }
+}
+
+impl From<UserStyle> for String {
+    fn from(style: UserStyle) -> Self {
+        style.name().to_owned()
+    }
+}
+
+impl std::fmt::Display for UserStyle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
     }
 }
 
@@ -115,6 +195,25 @@ impl Default for StoppingConfig {
 }
 
 impl LearnConfig {
+    /// This config for another cell of the test bed. Checked by
+    /// [`LearnConfig::validate`] and when the run starts, like a parsed config.
+    pub fn with_cell(mut self, cell: CellChoice) -> Self {
+        self.cell = cell;
+        self
+    }
+
+    /// This config for another simulated user.
+    pub fn with_user(mut self, user: UserConfig) -> Self {
+        self.user = user;
+        self
+    }
+
+    /// This config for another learning method.
+    pub fn with_method(mut self, method: Method) -> Self {
+        self.method = method;
+        self
+    }
+
     /// Parses and validates a TOML config.
     pub fn from_toml_str(text: &str) -> Result<LearnConfig, HarnessError> {
         let config: LearnConfig = toml::from_str(text)?;
@@ -184,5 +283,91 @@ impl LearnConfig {
             "{} / {} m / seed {} / {}",
             self.cell.speed_case, self.cell.headway_m, self.cell.seed, self.user.style
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DEFAULT: &str = include_str!("../../../configs/learn.toml");
+
+    fn user(text: &str) -> Result<UserConfig, toml::de::Error> {
+        toml::from_str(text)
+    }
+
+    #[test]
+    fn user_styles_read_and_write_as_names() {
+        for preset in StylePreset::ALL {
+            let parsed = user(&format!("style = \"{}\"", preset.name())).unwrap();
+            assert_eq!(parsed, UserConfig::preset(preset));
+            assert_eq!(parsed.style().unwrap(), preset.style());
+            let written = toml::to_string(&parsed).unwrap();
+            assert!(
+                written.contains(&format!("style = \"{}\"", preset.name())),
+                "{written}"
+            );
+        }
+        let custom = user(
+            "style = \"custom\"\n[custom]\ntime_headway_s = 1.3\nlane_change_duration_s = 2.0",
+        )
+        .unwrap();
+        assert_eq!(custom.style, UserStyle::Custom);
+        assert_eq!(custom.style().unwrap().time_headway_s, 1.3);
+        let preset: StylePreset =
+            toml::from_str::<std::collections::BTreeMap<String, StylePreset>>("p = \"cautious\"")
+                .unwrap()["p"];
+        assert_eq!(preset, StylePreset::Cautious);
+    }
+
+    #[test]
+    fn an_unknown_style_is_refused_when_parsed_listing_the_valid_names() {
+        let err = user("style = \"reckless\"").unwrap_err().to_string();
+        for name in [
+            "reckless",
+            "`aggressive`",
+            "`neutral`",
+            "`cautious`",
+            "`custom`",
+        ] {
+            assert!(err.contains(name), "{err}");
+        }
+        let text = DEFAULT.replace("style = \"neutral\"", "style = \"Neutral\"");
+        let err = LearnConfig::from_toml_str(&text).unwrap_err().to_string();
+        assert!(err.contains("`Neutral`"), "{err}");
+        let err = "reckless".parse::<UserStyle>().unwrap_err().to_string();
+        assert!(err.contains("`custom`"), "{err}");
+    }
+
+    #[test]
+    fn custom_without_its_table_is_refused_naming_the_field() {
+        let err = user("style = \"custom\"").unwrap().style().unwrap_err();
+        assert!(err.to_string().contains("user.custom"), "{err}");
+    }
+
+    #[test]
+    fn builders_replace_only_their_part() {
+        let base = LearnConfig::from_toml_str(DEFAULT).unwrap();
+        let cell = CellChoice {
+            speed_case: "arterial-slow".to_owned(),
+            headway_m: 35.0,
+            seed: 9,
+        };
+        let user = UserConfig::preset(StylePreset::Cautious);
+        let built = (base.clone())
+            .with_cell(cell.clone())
+            .with_user(user.clone())
+            .with_method(Method::Paper);
+        assert_eq!(built.cell, cell);
+        assert_eq!(built.user, user);
+        assert_eq!(built.method, Method::Paper);
+        let restored = (built.clone())
+            .with_cell(base.cell.clone())
+            .with_user(base.user.clone())
+            .with_method(base.method);
+        assert_eq!(restored, base);
+        assert_eq!(built.label(), "arterial-slow / 35 m / seed 9 / cautious");
+        built.validate().unwrap();
+        assert_eq!(built.cell().unwrap().adjacent_headway, 35.0);
     }
 }

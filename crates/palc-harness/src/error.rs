@@ -16,9 +16,14 @@ pub enum HarnessError {
         /// The bound it violates.
         bound: String,
     },
-    /// A style name that is none of the presets.
-    #[error("unknown driving style `{0}`: expected `aggressive`, `neutral` or `cautious`")]
-    UnknownStyle(String),
+    /// A style name that is none of the valid ones.
+    #[error("unknown driving style `{name}`: expected one of {expected}")]
+    UnknownStyle {
+        /// The name found.
+        name: String,
+        /// The valid names, quoted.
+        expected: String,
+    },
     /// A speed case that the scenario config does not define.
     #[error("unknown speed case `{0}`: the scenario config defines {1}")]
     UnknownSpeedCase(String, String),

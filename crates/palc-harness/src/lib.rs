@@ -7,13 +7,23 @@
 //! [`palc_zone_filter`]) learns from the lesson. Two methods run side by side
 //! ([`Method`]): the paper's, with only its equation errors corrected, and palc's.
 //!
+//! The loop is an executor, [`LearningLoop`]: `new` prepares a scenario, `step`
+//! drives one lane change and learns from a takeover, `termination` applies the
+//! stopping rules and `run` steps until they end the run; [`run`] is its one-call
+//! form. An [`Observer`] sees every lane change, every lesson as a [`LessonEvent`]
+//! (what the aggregator produced, or why it could not learn) and the
+//! [`RunSummary`], whose [`RunSummary::counted_takeovers`] is the paper's count.
+//! Configs are built from TOML or from a base with [`LearnConfig::with_cell`],
+//! [`LearnConfig::with_user`] and [`LearnConfig::with_method`]; users are
+//! [`StylePreset`]s or custom styles.
+//!
 //! ```no_run
 //! use palc_harness::{LearnConfig, NoObserver, run};
 //!
 //! let text = std::fs::read_to_string("configs/learn.toml")?;
 //! let config = LearnConfig::from_toml_str(&text)?;
 //! let result = run(&config, None, &mut NoObserver)?;
-//! println!("{:?} after {} takeovers", result.summary.outcome, result.summary.takeovers);
+//! println!("{:?} after {} takeovers", result.summary.outcome, result.summary.counted_takeovers());
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 #![warn(missing_docs)]
@@ -23,17 +33,24 @@ mod config;
 mod drive;
 mod error;
 mod learn;
+mod learning_loop;
+mod lesson;
 mod method;
+mod observer;
 mod record;
 mod setup;
 mod standard_alc;
 pub mod user;
 
-pub use config::{CellChoice, LearnConfig, StoppingConfig, UserConfig};
+pub use config::{CellChoice, LearnConfig, StoppingConfig, UserConfig, UserStyle};
 pub use drive::{Drive, execute, problem};
 pub use error::HarnessError;
-pub use learn::{NoObserver, Observer, PRESET_STYLES, RunResult, aggregator_options, prepare, run};
+pub use learn::{RunResult, aggregator_options, prepare, run};
+pub use learning_loop::LearningLoop;
 pub use method::{Driver, Method, label};
-pub use record::{LaneChangeRecord, Outcome, PartTimes, RunSummary, Takeover};
+pub use observer::{LessonEvent, NoObserver, Observer};
+pub use palc_aggregator::Timings;
+pub use record::{LaneChangeRecord, Outcome, RunSummary, Takeover};
 pub use setup::{PlanningConfig, Setup};
 pub use standard_alc::StandardWeights;
+pub use user::StylePreset;

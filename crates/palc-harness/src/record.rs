@@ -1,28 +1,7 @@
 //! What the loop reports: one record per lane change and a summary per run.
 
+use palc_aggregator::Timings;
 use serde::{Deserialize, Serialize};
-
-/// Compute time of one iteration, split by part (seconds).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-pub struct PartTimes {
-    /// Updating the zone model with the lesson's samples.
-    pub zone_fit_s: f64,
-    /// Projecting the zone onto lateral bounds.
-    pub bounds_s: f64,
-    /// Planning the expert trajectory.
-    pub expert_s: f64,
-    /// Correcting the weights (including its inner solves).
-    pub correction_s: f64,
-    /// Planning the next lane change.
-    pub plan_s: f64,
-}
-
-impl PartTimes {
-    /// The sum of all parts.
-    pub fn total_s(&self) -> f64 {
-        self.zone_fit_s + self.bounds_s + self.expert_s + self.correction_s + self.plan_s
-    }
-}
 
 /// Where and how the user took over.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -51,9 +30,10 @@ pub struct LaneChangeRecord {
     /// Perceived safety distance ratio (paper, Section III.A): distance covered
     /// before the takeover over the distance of the whole lane change; 1 without takeover.
     pub perceived_safety_ratio: f64,
-    /// Compute time of the learning step that followed (zero without takeover),
-    /// plus the time of planning this lane change.
-    pub times: PartTimes,
+    /// Compute time of the learning step that produced this lane change's plan
+    /// (zero for the first lane change, after a takeover-free one and after a
+    /// failed lesson), plus the time of planning it.
+    pub times: Timings,
     /// Step of the plan (s).
     pub dt: f64,
     /// Planned lateral positions, steps `0..=K` (m).
@@ -67,8 +47,9 @@ pub struct LaneChangeRecord {
     /// Whether the user's *nominal* trajectory, used as the plan, would have been
     /// taken over against this lane change's draw (the ceiling of a user with spread).
     pub nominal_plan_taken_over: bool,
-    /// Why the learning step after this lane change failed, if it did; the
-    /// experience then stays as it was.
+    /// Why the learning step after this lane change failed, if it did, as a
+    /// message for `--record` files; the experience then stays as it was.
+    /// Observers see the typed error in [`crate::LessonEvent::Failed`].
     pub learning_error: Option<String>,
 }
 
@@ -78,8 +59,22 @@ pub struct LaneChangeRecord {
 pub enum Outcome {
     /// The success criterion was met.
     Personalized,
-    /// The takeover cap was reached first.
+    /// The takeover cap (or, for a user with spread, the lane-change cap) was
+    /// reached first.
     CapReached,
+}
+
+impl Outcome {
+    /// The takeovers a run counts for in every statistic (the paper's N_lc,
+    /// Section III.B): a personalized run counts its `takeovers`; a run that
+    /// did not personalize counts as a failure at the `cap`, or at its own
+    /// takeovers if it took over more often than that.
+    pub fn counted_takeovers(self, takeovers: usize, cap: usize) -> usize {
+        match self {
+            Outcome::Personalized => takeovers,
+            Outcome::CapReached => cap.max(takeovers),
+        }
+    }
 }
 
 /// The summary of one run of the loop.
@@ -87,14 +82,71 @@ pub enum Outcome {
 pub struct RunSummary {
     /// How the run ended.
     pub outcome: Outcome,
-    /// Takeovers before success, or the cap when it was reached (paper's N_lc).
+    /// Takeovers that happened in the run; see [`RunSummary::counted_takeovers`]
+    /// for the number the statistics use.
     pub takeovers: usize,
+    /// The takeover cap of the run (`loop.max_takeovers`).
+    pub cap: usize,
     /// Lane changes driven in all.
     pub lane_changes: usize,
+    /// Lessons the method could not learn from (each left the experience as it
+    /// was; observers saw each as [`crate::LessonEvent::Failed`]).
+    pub learning_failures: usize,
     /// Largest `|planned − expected|` of the last lane change (m).
     pub final_max_deviation_m: f64,
     /// Takeover rate over the last window of lane changes (users with spread).
     pub final_takeover_rate: f64,
     /// Takeover rate of the user's nominal trajectory against the same draws.
     pub ceiling_takeover_rate: f64,
+}
+
+impl RunSummary {
+    /// Takeovers before success, or the cap when the run did not personalize
+    /// (the paper's N_lc; the rule of [`Outcome::counted_takeovers`]).
+    pub fn counted_takeovers(&self) -> usize {
+        self.outcome.counted_takeovers(self.takeovers, self.cap)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    #[test]
+    fn a_personalized_run_counts_its_takeovers_a_failed_one_the_cap() {
+        assert_eq!(Outcome::Personalized.counted_takeovers(4, 30), 4);
+        assert_eq!(Outcome::Personalized.counted_takeovers(0, 30), 0);
+        assert_eq!(Outcome::CapReached.counted_takeovers(30, 30), 30);
+        // A user with spread can stop at the lane-change cap with fewer takeovers.
+        assert_eq!(Outcome::CapReached.counted_takeovers(12, 30), 30);
+        assert_eq!(Outcome::CapReached.counted_takeovers(31, 30), 31);
+        let summary = RunSummary {
+            outcome: Outcome::CapReached,
+            takeovers: 12,
+            cap: 30,
+            lane_changes: 60,
+            learning_failures: 0,
+            final_max_deviation_m: 0.5,
+            final_takeover_rate: 0.2,
+            ceiling_takeover_rate: 0.1,
+        };
+        assert_eq!(summary.counted_takeovers(), 30);
+        let summary = RunSummary {
+            outcome: Outcome::Personalized,
+            ..summary
+        };
+        assert_eq!(summary.counted_takeovers(), 12);
+    }
+
+    proptest! {
+        /// A run that did not personalize never counts fewer takeovers than one
+        /// that did with the same takeovers, nor fewer than the cap.
+        #[test]
+        fn a_failure_never_counts_less_than_a_success(takeovers in 0usize..100, cap in 1usize..60) {
+            let failed = Outcome::CapReached.counted_takeovers(takeovers, cap);
+            prop_assert!(failed >= Outcome::Personalized.counted_takeovers(takeovers, cap));
+            prop_assert!(failed >= cap);
+        }
+    }
 }

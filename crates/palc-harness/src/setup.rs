@@ -13,7 +13,7 @@ use palc_traffic::{EgoState, Lane, Scene};
 use serde::{Deserialize, Serialize};
 
 use crate::HarnessError;
-use crate::user::{ExpectedLaneChange, Situation, Style};
+use crate::user::{ExpectedLaneChange, Situation, Style, StylePreset};
 
 /// Parameters of the planning set-up; defaults in `configs/learn.toml`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -210,7 +210,7 @@ impl Setup {
             ))
         })?;
         let mut latest_user = 0;
-        for style in [Style::AGGRESSIVE, Style::NEUTRAL, Style::CAUTIOUS] {
+        for style in StylePreset::ALL.map(StylePreset::style) {
             let start = style.start_step(&situations).ok_or_else(|| {
                 scenario_error(format!(
                     "a user ({} s headway) never starts within the {} s search window",
@@ -275,11 +275,12 @@ impl Setup {
     pub fn check_conservative(
         &self,
         standard: &Style,
-        styles: &[(&str, Style)],
+        styles: &[StylePreset],
     ) -> Result<(), String> {
         let standard_start = self.standard_start_step as f64 * self.dt;
-        for (name, style) in styles {
-            let Some(expected) = self.expected(style) else {
+        for preset in styles {
+            let (name, style) = (preset.name(), preset.style());
+            let Some(expected) = self.expected(&style) else {
                 return Err(format!(
                     "the {name} user does not change lanes within the horizon"
                 ));

@@ -54,16 +54,6 @@ impl Style {
         0.6
     }
 
-    /// The preset with this name (`aggressive`, `neutral` or `cautious`).
-    pub fn named(name: &str) -> Result<Style, HarnessError> {
-        match name {
-            "aggressive" => Ok(Self::AGGRESSIVE),
-            "neutral" => Ok(Self::NEUTRAL),
-            "cautious" => Ok(Self::CAUTIOUS),
-            other => Err(HarnessError::UnknownStyle(other.to_owned())),
-        }
-    }
-
     /// Checks every field is finite and positive, naming the first that is not.
     pub fn validate(&self, field: &str) -> Result<(), HarnessError> {
         let fields = [
@@ -90,6 +80,76 @@ impl Style {
             lane_change_duration_s: self.lane_change_duration_s * (1.0 + e_t),
             ..self
         }
+    }
+}
+
+/// The paper's three driving styles (Section III.A), by name.
+///
+/// Serializes as its [`name`](StylePreset::name): `aggressive`, `neutral` or
+/// `cautious`; parsing any other name is refused with the list of valid ones.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StylePreset {
+    /// [`Style::AGGRESSIVE`].
+    Aggressive,
+    /// [`Style::NEUTRAL`].
+    Neutral,
+    /// [`Style::CAUTIOUS`].
+    Cautious,
+}
+
+impl StylePreset {
+    /// The three presets, from the shortest headway to the longest.
+    pub const ALL: [StylePreset; 3] = [
+        StylePreset::Aggressive,
+        StylePreset::Neutral,
+        StylePreset::Cautious,
+    ];
+
+    /// The preset's name in configs and reports.
+    pub const fn name(self) -> &'static str {
+        match self {
+            StylePreset::Aggressive => "aggressive",
+            StylePreset::Neutral => "neutral",
+            StylePreset::Cautious => "cautious",
+        }
+    }
+
+    /// The style of this preset.
+    pub const fn style(self) -> Style {
+        match self {
+            StylePreset::Aggressive => Style::AGGRESSIVE,
+            StylePreset::Neutral => Style::NEUTRAL,
+            StylePreset::Cautious => Style::CAUTIOUS,
+        }
+    }
+
+    /// The valid names, quoted, for messages: `` `aggressive`, `neutral`, `cautious` ``.
+    pub(crate) fn quoted_names() -> String {
+        Self::ALL
+            .map(|preset| format!("`{}`", preset.name()))
+            .join(", ")
+    }
+}
+
+impl std::fmt::Display for StylePreset {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for StylePreset {
+    type Err = HarnessError;
+
+    /// The preset with this name; [`HarnessError::UnknownStyle`] lists the valid names.
+    fn from_str(name: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .into_iter()
+            .find(|preset| preset.name() == name)
+            .ok_or_else(|| HarnessError::UnknownStyle {
+                name: name.to_owned(),
+                expected: Self::quoted_names(),
+            })
     }
 }
 
@@ -255,6 +315,19 @@ pub fn max_deviation(planned_l: &[f64], expected_l: &[f64]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn presets_round_trip_through_their_names() {
+        for preset in StylePreset::ALL {
+            assert_eq!(preset.name().parse::<StylePreset>().unwrap(), preset);
+            assert_eq!(preset.to_string(), preset.name());
+        }
+        assert_eq!(StylePreset::Neutral.style(), Style::NEUTRAL);
+        let err = "reckless".parse::<StylePreset>().unwrap_err().to_string();
+        for name in ["reckless", "`aggressive`", "`neutral`", "`cautious`"] {
+            assert!(err.contains(name), "{err}");
+        }
+    }
 
     #[test]
     fn quintic_has_flat_ends_and_is_monotone() {

@@ -2,14 +2,16 @@
 //! `configs/learn.toml` (issue: harness, "Tests").
 
 use palc_harness::user::Style;
-use palc_harness::{LearnConfig, Method, NoObserver, Outcome, RunResult, run};
+use palc_harness::{LearnConfig, Method, NoObserver, Outcome, RunResult, UserConfig, run};
 
 fn config(method: Method, style: &str) -> LearnConfig {
     let text = include_str!("../../../configs/learn.toml");
-    let mut config = LearnConfig::from_toml_str(text).expect("the default config parses");
-    config.method = method;
-    config.user.style = style.to_owned();
-    config
+    let config = LearnConfig::from_toml_str(text).expect("the default config parses");
+    let user = UserConfig {
+        style: style.parse().expect("a valid style name"),
+        ..config.user.clone()
+    };
+    config.with_method(method).with_user(user)
 }
 
 fn learn(config: &LearnConfig) -> RunResult {
@@ -27,7 +29,7 @@ fn palc_personalizes_every_style_in_the_default_scenario() {
             result.summary
         );
         assert!(
-            result.summary.takeovers < 30,
+            result.summary.counted_takeovers() < 30,
             "{style}: {:?}",
             result.summary
         );
@@ -85,7 +87,7 @@ fn the_paper_method_runs_and_reports_its_outcome() {
         );
     }
     if result.summary.outcome == Outcome::CapReached {
-        assert_eq!(result.summary.takeovers, 30);
+        assert_eq!(result.summary.counted_takeovers(), 30);
     }
 }
 
@@ -112,10 +114,18 @@ fn invalid_configs_are_refused_naming_the_field() {
     let err = run(&bad, None, &mut NoObserver).unwrap_err().to_string();
     assert!(err.contains("planning.takeover_threshold_m"), "{err}");
 
-    let mut bad = config(Method::Palc, "reckless");
-    bad.user.custom = None;
-    let err = run(&bad, None, &mut NoObserver).unwrap_err().to_string();
-    assert!(err.contains("reckless"), "{err}");
+    let text = include_str!("../../../configs/learn.toml")
+        .replace("style = \"neutral\"", "style = \"reckless\"");
+    let err = LearnConfig::from_toml_str(&text).unwrap_err().to_string();
+    for name in [
+        "reckless",
+        "`aggressive`",
+        "`neutral`",
+        "`cautious`",
+        "`custom`",
+    ] {
+        assert!(err.contains(name), "{err}");
+    }
 
     let mut bad = config(Method::Palc, "neutral");
     bad.cell.speed_case = "autobahn".to_owned();
@@ -130,4 +140,97 @@ fn invalid_configs_are_refused_naming_the_field() {
     bad.user.custom = Some(custom);
     let err = run(&bad, None, &mut NoObserver).unwrap_err().to_string();
     assert!(err.contains("user.custom.time_headway_s"), "{err}");
+}
+
+/// Counts what the loop tells an observer.
+#[derive(Default)]
+struct Tally {
+    lane_changes: Vec<palc_harness::LaneChangeRecord>,
+    learned: Vec<usize>,
+    failed: Vec<usize>,
+    expert_lengths: Vec<usize>,
+    finished: Option<palc_harness::RunSummary>,
+}
+
+impl palc_harness::Observer for Tally {
+    fn lane_change(&mut self, record: &palc_harness::LaneChangeRecord) {
+        self.lane_changes.push(record.clone());
+    }
+
+    fn lesson(&mut self, event: &palc_harness::LessonEvent<'_>) {
+        match event {
+            palc_harness::LessonEvent::Learned {
+                lane_change,
+                outcome,
+                ..
+            } => {
+                self.learned.push(*lane_change);
+                self.expert_lengths.push(outcome.expert.states.len());
+            }
+            palc_harness::LessonEvent::Failed { lane_change, .. } => self.failed.push(*lane_change),
+        }
+    }
+
+    fn finished(&mut self, summary: &palc_harness::RunSummary) {
+        self.finished = Some(summary.clone());
+    }
+}
+
+#[test]
+fn observers_see_one_lesson_event_per_takeover_learned_from() {
+    for (method, style) in [(Method::Palc, "cautious"), (Method::Paper, "neutral")] {
+        let config = config(method, style);
+        let mut tally = Tally::default();
+        let result = run(&config, None, &mut tally).unwrap();
+        let summary = &result.summary;
+        assert_eq!(tally.finished.as_ref(), Some(summary));
+        assert_eq!(tally.lane_changes.len(), result.records.len());
+        // Every takeover is learned from, except the one that reaches the cap.
+        let learned_from = if summary.takeovers >= summary.cap {
+            summary.takeovers - 1
+        } else {
+            summary.takeovers
+        };
+        assert_eq!(
+            tally.learned.len() + tally.failed.len(),
+            learned_from,
+            "{method:?}"
+        );
+        assert_eq!(tally.failed.len(), summary.learning_failures);
+        let with_error: Vec<usize> = (result.records.iter())
+            .filter(|r| r.learning_error.is_some())
+            .map(|r| r.index)
+            .collect();
+        assert_eq!(tally.failed, with_error);
+        // Each event names a taken-over lane change, in order.
+        let mut events: Vec<usize> = tally.learned.iter().chain(&tally.failed).copied().collect();
+        events.sort_unstable();
+        events.dedup();
+        assert_eq!(events.len(), learned_from);
+        assert!(events.iter().all(|&i| result.records[i].takeover.is_some()));
+        assert!(
+            tally
+                .expert_lengths
+                .iter()
+                .all(|&n| n == result.horizon + 1)
+        );
+    }
+}
+
+#[test]
+fn stepping_the_loop_by_hand_gives_the_run() {
+    let config = config(Method::Palc, "aggressive");
+    let whole = learn(&config);
+    let mut by_hand = palc_harness::LearningLoop::new(&config, None).unwrap();
+    let mut indices = Vec::new();
+    while by_hand.termination().is_none() {
+        indices.push(by_hand.step(&mut NoObserver).unwrap().index);
+    }
+    assert_eq!(by_hand.termination(), Some(whole.summary.outcome));
+    assert_eq!(indices, (0..whole.records.len()).collect::<Vec<_>>());
+    for (x, y) in by_hand.records().iter().zip(&whole.records) {
+        assert_eq!(x.planned_l, y.planned_l);
+        assert_eq!(x.takeover, y.takeover);
+    }
+    assert_eq!(by_hand.experience().weights, whole.experience.weights);
 }

@@ -5,7 +5,10 @@ use std::path::PathBuf;
 use anyhow::Context;
 use clap::Args;
 use palc_aggregator::Experience;
-use palc_harness::{LaneChangeRecord, LearnConfig, Method, Observer, RunSummary, run};
+use palc_harness::{
+    CellChoice, LaneChangeRecord, LearnConfig, LessonEvent, Method, Observer, RunSummary,
+    UserConfig, UserStyle, run,
+};
 
 /// The default config, compiled in so that `palc learn` alone works anywhere.
 const DEFAULT_CONFIG: &str = include_str!("../../../../configs/learn.toml");
@@ -19,9 +22,10 @@ pub struct LearnArgs {
     /// Learning method: `paper` or `palc`.
     #[arg(long)]
     method: Option<String>,
-    /// Driving style: `aggressive`, `neutral` or `cautious`.
+    /// Driving style: `aggressive`, `neutral`, `cautious`, or `custom` for the
+    /// config's `[user.custom]` table.
     #[arg(long)]
-    style: Option<String>,
+    style: Option<UserStyle>,
     /// Speed case by name, e.g. `collector-high`.
     #[arg(long)]
     speed: Option<String>,
@@ -62,7 +66,10 @@ impl Observer for Printer {
                 record.max_deviation_m
             ),
         }
-        if let Some(error) = &record.learning_error {
+    }
+
+    fn lesson(&mut self, event: &LessonEvent<'_>) {
+        if let LessonEvent::Failed { error, .. } = event {
             println!("               learning step failed, experience unchanged: {error}");
         }
     }
@@ -70,8 +77,17 @@ impl Observer for Printer {
     fn finished(&mut self, summary: &RunSummary) {
         println!(
             "{:?} after {} takeovers in {} lane changes (final max deviation {:.2} m)",
-            summary.outcome, summary.takeovers, summary.lane_changes, summary.final_max_deviation_m
+            summary.outcome,
+            summary.counted_takeovers(),
+            summary.lane_changes,
+            summary.final_max_deviation_m
         );
+        if summary.learning_failures > 0 {
+            println!(
+                "{} of the lessons could not be learned from",
+                summary.learning_failures
+            );
+        }
     }
 }
 
@@ -90,21 +106,23 @@ pub fn run_learn(args: LearnArgs) -> anyhow::Result<()> {
     };
     let mut config = LearnConfig::from_toml_str(&text).with_context(|| format!("in {source}"))?;
     if let Some(name) = &args.method {
-        config.method = Method::named(name)
+        let method = Method::named(name)
             .with_context(|| format!("unknown method `{name}`: expected `paper` or `palc`"))?;
+        config = config.with_method(method);
     }
-    if let Some(style) = &args.style {
-        config.user.style = style.clone();
+    if let Some(style) = args.style {
+        let user = UserConfig {
+            style,
+            ..config.user.clone()
+        };
+        config = config.with_user(user);
     }
-    if let Some(speed) = &args.speed {
-        config.cell.speed_case = speed.clone();
-    }
-    if let Some(headway) = args.headway {
-        config.cell.headway_m = headway;
-    }
-    if let Some(seed) = args.seed {
-        config.cell.seed = seed;
-    }
+    let cell = CellChoice {
+        speed_case: args.speed.unwrap_or_else(|| config.cell.speed_case.clone()),
+        headway_m: args.headway.unwrap_or(config.cell.headway_m),
+        seed: args.seed.unwrap_or(config.cell.seed),
+    };
+    let config = config.with_cell(cell);
     let experience = match &args.experience {
         Some(path) => Some(
             Experience::load(path).with_context(|| format!("cannot load {}", path.display()))?,

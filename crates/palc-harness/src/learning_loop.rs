@@ -1,0 +1,596 @@
+//! The lesson-learning loop of paper Fig. 2 as an executor (in the shape of
+//! argmin's `Executor`): [`LearningLoop::new`] prepares the scenario and the first
+//! plan, [`LearningLoop::step`] drives one lane change and, on a takeover, learns
+//! from it, [`LearningLoop::termination`] says whether the run is over, and
+//! [`LearningLoop::run`] repeats the step until it is.
+
+use std::time::Instant;
+
+use palc_aggregator::{
+    AggregatorError, AggregatorOptions, Experience, StepOutcome, Timings, learn_from_lesson,
+    plan_problem,
+};
+use palc_planner::{LateralBoundsMode, Plan, Planner, PlannerConfig, Problem};
+
+use crate::HarnessError;
+use crate::config::{LearnConfig, StoppingConfig};
+use crate::drive::{Drive, execute, problem};
+use crate::learn::{RunResult, aggregator_options, prepare};
+use crate::lesson::{lesson, scenes, zone_feature_set};
+use crate::method::Method;
+use crate::observer::{LessonEvent, Observer};
+use crate::record::{LaneChangeRecord, Outcome, RunSummary};
+use crate::setup::Setup;
+use crate::user::{User, first_takeover};
+
+/// One run of the lesson-learning loop (paper Fig. 2): plan with the experience,
+/// let the simulated user judge the lane change, and on a takeover label the lesson,
+/// update the zone and correct the weights (Eqs. 24-36), until the user stops
+/// taking over or a cap is reached.
+///
+/// ```no_run
+/// use palc_harness::{LearnConfig, LearningLoop, NoObserver};
+///
+/// let config = LearnConfig::from_toml_str(&std::fs::read_to_string("configs/learn.toml")?)?;
+/// let mut run = LearningLoop::new(&config, None)?;
+/// while run.termination().is_none() {
+///     let record = run.step(&mut NoObserver)?;
+///     println!("lane change {}: takeover {:?}", record.index, record.takeover);
+/// }
+/// # Ok::<(), Box<dyn std::error::Error>>(())
+/// ```
+#[derive(Debug)]
+pub struct LearningLoop {
+    label: String,
+    method: Method,
+    stopping: StoppingConfig,
+    takeover_threshold_m: f64,
+    options: AggregatorOptions,
+    setup: Setup,
+    planner: Planner,
+    user: User,
+    /// The user's nominal expected lateral path: the ceiling of a user with spread.
+    nominal_l: Vec<f64>,
+    /// The scenario without weights or zone: the aggregator fills both in.
+    template: Problem,
+    experience: Experience,
+    next_plan: Plan,
+    /// Compute time of the step that produced `next_plan`.
+    pending_times: Timings,
+    records: Vec<LaneChangeRecord>,
+    takeovers: usize,
+    /// Takeover-free lane changes since the last takeover.
+    streak: usize,
+    learning_failures: usize,
+    /// Whether the last lane change's lesson failed.
+    last_lesson_failed: bool,
+}
+
+impl LearningLoop {
+    /// Prepares the run of `config`: builds and checks the scenario
+    /// ([`prepare`]), the planner, the simulated user and the first plan, starting
+    /// from `experience` if given (its weights resampled to this scenario's horizon
+    /// and step), else from the standard ALC's weights.
+    ///
+    /// # Errors
+    /// Invalid config or options, a scenario the paper's premise does not hold in
+    /// ([`HarnessError::Scenario`]), or a first plan that cannot be solved.
+    pub fn new(
+        config: &LearnConfig,
+        experience: Option<&Experience>,
+    ) -> Result<Self, HarnessError> {
+        let setup = prepare(config)?;
+        let options = aggregator_options(config);
+        options.validate()?;
+        let experience = starting_experience(config, &setup, experience)?;
+        let mut planner = Planner::new(PlannerConfig {
+            horizon: setup.horizon,
+            dt: setup.dt,
+            lateral_bounds_mode: match config.method {
+                Method::Paper => LateralBoundsMode::Hard,
+                Method::Palc => config.planner.lateral_bounds_mode,
+            },
+            ..config.planner.clone()
+        })?;
+        let nominal = config.user.style()?;
+        let user = match config.user.spread {
+            Some(spread) => User::with_spread(nominal, spread)?,
+            None => User::deterministic(nominal)?,
+        };
+        let nominal_l = setup
+            .expected(&nominal)
+            .ok_or_else(|| HarnessError::Scenario {
+                scenario: config.label(),
+                reason: "the user does not change lanes within the horizon".to_owned(),
+            })?
+            .sample(setup.horizon, setup.dt);
+        let template = problem(&setup, experience.weights.clone(), Vec::new());
+        let (first_problem, _) = plan_problem(
+            &planner,
+            &experience,
+            &template,
+            &scenes(&setup, None),
+            &options,
+        )?;
+        let started = Instant::now();
+        let next_plan = planner.plan(&first_problem)?;
+        let pending_times = Timings {
+            plan_s: started.elapsed().as_secs_f64(),
+            ..Timings::default()
+        };
+        Ok(LearningLoop {
+            label: config.label(),
+            method: config.method,
+            stopping: config.stopping,
+            takeover_threshold_m: config.planning.takeover_threshold_m,
+            options,
+            setup,
+            planner,
+            user,
+            nominal_l,
+            template,
+            experience,
+            next_plan,
+            pending_times,
+            records: Vec::new(),
+            takeovers: 0,
+            streak: 0,
+            learning_failures: 0,
+            last_lesson_failed: false,
+        })
+    }
+
+    /// Drives one lane change with the current plan and, when the user takes over
+    /// and the takeover cap is not reached, learns from the lesson (Fig. 2's
+    /// learning branch). Observers see the lane change, then the lesson's
+    /// [`LessonEvent`]. Returns the lane change's record.
+    ///
+    /// A lesson the method cannot learn from is not an error of the run: the
+    /// experience and the plan stay as they were, observers see
+    /// [`LessonEvent::Failed`], and the record keeps the message.
+    ///
+    /// # Errors
+    /// A drawn user who does not change lanes within the horizon, or a plan, drive
+    /// or feature error.
+    pub fn step(&mut self, observer: &mut dyn Observer) -> Result<&LaneChangeRecord, HarnessError> {
+        let drive = self.drive()?;
+        let record = self.record(&drive);
+        let index = record.index;
+        observer.lane_change(&record);
+        self.records.push(record);
+        self.pending_times = Timings::default();
+        self.last_lesson_failed = false;
+        match drive.takeover {
+            Some(takeover) => {
+                self.takeovers += 1;
+                self.streak = 0;
+                if self.takeovers < self.stopping.max_takeovers {
+                    self.learn(index, &drive, takeover.step, observer)?;
+                }
+            }
+            None => self.streak += 1,
+        }
+        Ok(&self.records[index])
+    }
+
+    /// How the run ends, once it has: [`Outcome::CapReached`] when the takeovers
+    /// reach `loop.max_takeovers`; [`Outcome::Personalized`] on the success rule
+    /// (`success_streak` takeover-free lane changes in a row, the paper's three; for
+    /// a user with spread, the window's takeover rate within the margin of the
+    /// nominal plan's); [`Outcome::CapReached`] at the lane-change cap
+    /// (`max(max_lane_changes, max_takeovers + success_streak)`). `None` while the
+    /// run goes on.
+    ///
+    /// After a failed lesson only the takeover cap ends the run: the next lane
+    /// change repeats the plan and is judged instead.
+    pub fn termination(&self) -> Option<Outcome> {
+        termination(
+            &self.stopping,
+            &self.records,
+            Progress {
+                takeovers: self.takeovers,
+                streak: self.streak,
+                last_lesson_failed: self.last_lesson_failed,
+            },
+        )
+    }
+
+    /// Runs [`LearningLoop::step`] until [`LearningLoop::termination`] says the run
+    /// is over, then tells the observer the summary.
+    ///
+    /// # Errors
+    /// Those of [`LearningLoop::step`].
+    pub fn run(mut self, observer: &mut dyn Observer) -> Result<RunResult, HarnessError> {
+        let outcome = loop {
+            self.step(observer)?;
+            if let Some(outcome) = self.termination() {
+                break outcome;
+            }
+        };
+        let summary = self.summary(outcome);
+        observer.finished(&summary);
+        Ok(RunResult {
+            label: self.label,
+            method: self.method,
+            horizon: self.setup.horizon,
+            dt: self.setup.dt,
+            summary,
+            records: self.records,
+            experience: self.experience,
+        })
+    }
+
+    /// The lane changes driven so far.
+    pub fn records(&self) -> &[LaneChangeRecord] {
+        &self.records
+    }
+
+    /// What has been learned so far.
+    pub fn experience(&self) -> &Experience {
+        &self.experience
+    }
+
+    /// The plan the next lane change will drive.
+    pub fn next_plan(&self) -> &Plan {
+        &self.next_plan
+    }
+
+    /// Draws the user of the next lane change and drives the current plan in the scene.
+    fn drive(&mut self) -> Result<Drive, HarnessError> {
+        let style = self.user.next_style();
+        let expected = self
+            .setup
+            .expected(&style)
+            .ok_or_else(|| HarnessError::Scenario {
+                scenario: self.label.clone(),
+                reason: format!(
+                    "a drawn user (headway {:.3} s, duration {:.3} s) does not change lanes within the horizon",
+                    style.time_headway_s, style.lane_change_duration_s
+                ),
+            })?;
+        execute(
+            &self.setup,
+            self.next_plan.clone(),
+            expected,
+            self.takeover_threshold_m,
+        )
+    }
+
+    /// The record of a driven lane change.
+    fn record(&self, drive: &Drive) -> LaneChangeRecord {
+        LaneChangeRecord {
+            index: self.records.len(),
+            takeovers_before: self.takeovers,
+            takeover: drive.takeover,
+            max_deviation_m: drive.max_deviation_m,
+            perceived_safety_ratio: drive.perceived_safety_ratio,
+            times: self.pending_times,
+            dt: self.setup.dt,
+            planned_l: drive.plan.states.iter().map(|x| x.l).collect(),
+            expected_l: drive.expected_l.clone(),
+            driven_l: drive.driven.iter().map(|x| x.l).collect(),
+            with_spread: self.user.has_spread(),
+            nominal_plan_taken_over: first_takeover(
+                &self.nominal_l,
+                &drive.expected_l,
+                self.takeover_threshold_m,
+            )
+            .is_some(),
+            learning_error: None,
+        }
+    }
+
+    /// Learns from the lesson of lane change `lane_change` (taken over at
+    /// `takeover_step`) and tells the observer what it produced.
+    fn learn(
+        &mut self,
+        lane_change: usize,
+        drive: &Drive,
+        takeover_step: usize,
+        observer: &mut dyn Observer,
+    ) -> Result<(), HarnessError> {
+        // The samples update the zone, so they take its features (Eq. 1 or a variant).
+        let feature_set = zone_feature_set(&self.experience, &self.options);
+        let lesson = lesson(self.method, &self.setup, drive, takeover_step, feature_set)?;
+        let result: Result<StepOutcome, AggregatorError> = learn_from_lesson(
+            &mut self.planner,
+            &self.experience,
+            &lesson,
+            &self.template,
+            &self.options,
+        );
+        match result {
+            Ok(outcome) => {
+                observer.lesson(&LessonEvent::Learned {
+                    lane_change,
+                    lesson: &lesson,
+                    outcome: &outcome,
+                });
+                self.pending_times = outcome.timings;
+                self.experience = outcome.experience;
+                self.next_plan = outcome.plan;
+            }
+            Err(error) => {
+                observer.lesson(&LessonEvent::Failed {
+                    lane_change,
+                    lesson: &lesson,
+                    error: &error,
+                });
+                self.learning_failures += 1;
+                self.last_lesson_failed = true;
+                if let Some(record) = self.records.get_mut(lane_change) {
+                    record.learning_error = Some(error.to_string());
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The summary of a run that ended with `outcome`.
+    fn summary(&self, outcome: Outcome) -> RunSummary {
+        let records = &self.records;
+        let window = &records[records.len().saturating_sub(self.stopping.spread_window)..];
+        let rate = |f: fn(&LaneChangeRecord) -> bool| {
+            window.iter().filter(|r| f(r)).count() as f64 / window.len().max(1) as f64
+        };
+        RunSummary {
+            outcome,
+            takeovers: self.takeovers,
+            cap: self.stopping.max_takeovers,
+            lane_changes: records.len(),
+            learning_failures: self.learning_failures,
+            final_max_deviation_m: records.last().map_or(0.0, |r| r.max_deviation_m),
+            final_takeover_rate: rate(|r| r.takeover.is_some()),
+            ceiling_takeover_rate: rate(|r| r.nominal_plan_taken_over),
+        }
+    }
+}
+
+/// The experience a run starts from: `previous` carried into this scenario (weights
+/// resampled to its horizon and step), or a fresh one with the standard ALC's weights.
+fn starting_experience(
+    config: &LearnConfig,
+    setup: &Setup,
+    previous: Option<&Experience>,
+) -> Result<Experience, HarnessError> {
+    let (k, dt) = (setup.horizon, setup.dt);
+    match previous {
+        Some(previous) => {
+            let mut carried = previous.clone();
+            carried.weights = previous.weights_for(k, dt)?;
+            carried.metadata.dt = dt;
+            carried.metadata.scenario = config.label();
+            Ok(carried)
+        }
+        None => {
+            let standard = setup.standard_lane_change(&config.planning.standard_alc);
+            let weights = config.standard_weights.weights(&standard, k, dt);
+            Ok(Experience::new(
+                config.user.style.name(),
+                config.label(),
+                config.method.name(),
+                weights,
+                dt,
+            )?)
+        }
+    }
+}
+
+/// The counters [`termination`] reads besides the records.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+struct Progress {
+    /// Takeovers so far.
+    takeovers: usize,
+    /// Takeover-free lane changes since the last takeover.
+    streak: usize,
+    /// Whether the last lane change's lesson failed.
+    last_lesson_failed: bool,
+}
+
+/// The rule of [`LearningLoop::termination`].
+fn termination(
+    stopping: &StoppingConfig,
+    records: &[LaneChangeRecord],
+    progress: Progress,
+) -> Option<Outcome> {
+    if progress.takeovers >= stopping.max_takeovers {
+        return Some(Outcome::CapReached);
+    }
+    if progress.last_lesson_failed {
+        return None;
+    }
+    if success(records, progress.streak, stopping) {
+        return Some(Outcome::Personalized);
+    }
+    let lane_change_cap = stopping
+        .max_lane_changes
+        .max(stopping.max_takeovers + stopping.success_streak);
+    (records.len() >= lane_change_cap).then_some(Outcome::CapReached)
+}
+
+/// Whether the run has succeeded: `success_streak` takeover-free lane changes in a
+/// row for a deterministic user; for a user with spread, the takeover rate over the
+/// last window within the margin of the nominal plan's rate on the same draws.
+fn success(records: &[LaneChangeRecord], streak: usize, stopping: &StoppingConfig) -> bool {
+    let with_spread = records.last().is_some_and(|r| r.with_spread);
+    if !with_spread {
+        return streak >= stopping.success_streak;
+    }
+    if records.len() < stopping.spread_window {
+        return false;
+    }
+    let window = &records[records.len() - stopping.spread_window..];
+    let n = window.len() as f64;
+    let taken = window.iter().filter(|r| r.takeover.is_some()).count() as f64 / n;
+    let ceiling = window.iter().filter(|r| r.nominal_plan_taken_over).count() as f64 / n;
+    taken <= ceiling + stopping.spread_margin
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::record::Takeover;
+
+    fn stopping() -> StoppingConfig {
+        StoppingConfig {
+            max_takeovers: 4,
+            success_streak: 3,
+            spread_window: 5,
+            spread_margin: 0.1,
+            max_lane_changes: 12,
+        }
+    }
+
+    /// A lane change, taken over or not, of a user with or without spread whose
+    /// nominal plan would (not) have been taken over.
+    fn record(
+        index: usize,
+        taken: bool,
+        with_spread: bool,
+        nominal_taken: bool,
+    ) -> LaneChangeRecord {
+        LaneChangeRecord {
+            index,
+            takeovers_before: 0,
+            takeover: taken.then_some(Takeover {
+                step: 10,
+                time_s: 1.0,
+                distance_m: 20.0,
+                deviation_m: 0.4,
+            }),
+            max_deviation_m: if taken { 0.4 } else { 0.1 },
+            perceived_safety_ratio: if taken { 0.5 } else { 1.0 },
+            times: Timings::default(),
+            dt: 0.1,
+            planned_l: Vec::new(),
+            expected_l: Vec::new(),
+            driven_l: Vec::new(),
+            with_spread,
+            nominal_plan_taken_over: nominal_taken,
+            learning_error: None,
+        }
+    }
+
+    /// Records of a deterministic user from a pattern: `T` a takeover, `-` none.
+    fn deterministic(pattern: &str) -> Vec<LaneChangeRecord> {
+        pattern
+            .chars()
+            .enumerate()
+            .map(|(i, c)| record(i, c == 'T', false, false))
+            .collect()
+    }
+
+    /// Replays `pattern` through the counters the loop keeps.
+    fn progress(pattern: &str) -> Progress {
+        pattern.chars().fold(Progress::default(), |p, c| match c {
+            'T' => Progress {
+                takeovers: p.takeovers + 1,
+                streak: 0,
+                ..p
+            },
+            _ => Progress {
+                streak: p.streak + 1,
+                ..p
+            },
+        })
+    }
+
+    fn judge(pattern: &str) -> Option<Outcome> {
+        termination(&stopping(), &deterministic(pattern), progress(pattern))
+    }
+
+    #[test]
+    fn a_deterministic_user_personalizes_after_the_success_streak() {
+        assert_eq!(judge(""), None);
+        assert_eq!(judge("T-"), None);
+        assert_eq!(judge("T--"), None);
+        assert_eq!(judge("T---"), Some(Outcome::Personalized));
+        assert_eq!(judge("---"), Some(Outcome::Personalized));
+    }
+
+    #[test]
+    fn the_takeover_cap_ends_the_run_before_anything_else() {
+        assert_eq!(judge("TTT"), None);
+        assert_eq!(judge("TTTT"), Some(Outcome::CapReached));
+        assert_eq!(judge("T-T-T--T"), Some(Outcome::CapReached));
+        let failed = Progress {
+            last_lesson_failed: true,
+            ..progress("TTTT")
+        };
+        let records = deterministic("TTTT");
+        assert_eq!(
+            termination(&stopping(), &records, failed),
+            Some(Outcome::CapReached)
+        );
+    }
+
+    #[test]
+    fn after_a_failed_lesson_only_the_takeover_cap_is_checked() {
+        // With spread, a window within the margin would be success, and 12 lane
+        // changes reach the lane-change cap; a failed lesson defers both.
+        let records: Vec<_> = (0..12).map(|i| record(i, i == 11, true, i == 11)).collect();
+        let p = Progress {
+            takeovers: 1,
+            streak: 0,
+            last_lesson_failed: true,
+        };
+        assert_eq!(termination(&stopping(), &records, p), None);
+        let p = Progress {
+            last_lesson_failed: false,
+            ..p
+        };
+        assert_eq!(
+            termination(&stopping(), &records, p),
+            Some(Outcome::Personalized)
+        );
+    }
+
+    #[test]
+    fn a_user_with_spread_is_judged_on_the_window_against_the_ceiling() {
+        let s = stopping();
+        // Five lane changes, two taken over, the nominal plan would have had one:
+        // 0.4 > 0.2 + 0.1, not yet personalized.
+        let pattern = [true, false, true, false, false];
+        let records: Vec<_> = (pattern.iter().enumerate())
+            .map(|(i, &t)| record(i, t, true, i == 0))
+            .collect();
+        let p = Progress {
+            takeovers: 2,
+            streak: 2,
+            last_lesson_failed: false,
+        };
+        assert_eq!(termination(&s, &records, p), None);
+        // Too short a window is never success, whatever the streak.
+        assert_eq!(
+            termination(&s, &records[..4], Progress { streak: 9, ..p }),
+            None
+        );
+        // The ceiling at two of five: 0.4 <= 0.4 + 0.1.
+        let records: Vec<_> = (pattern.iter().enumerate())
+            .map(|(i, &t)| record(i, t, true, i < 2))
+            .collect();
+        assert_eq!(termination(&s, &records, p), Some(Outcome::Personalized));
+    }
+
+    #[test]
+    fn a_user_with_spread_stops_at_the_lane_change_cap() {
+        let s = stopping();
+        let records: Vec<_> = (0..12)
+            .map(|i| record(i, i % 2 == 0, true, false))
+            .collect();
+        let p = Progress {
+            takeovers: 3,
+            streak: 1,
+            last_lesson_failed: false,
+        };
+        assert_eq!(termination(&s, &records[..11], p), None);
+        assert_eq!(termination(&s, &records, p), Some(Outcome::CapReached));
+        // The cap is at least max_takeovers + success_streak lane changes.
+        let s = StoppingConfig {
+            max_lane_changes: 1,
+            ..s
+        };
+        assert_eq!(termination(&s, &records[..6], p), None);
+        assert_eq!(termination(&s, &records[..7], p), Some(Outcome::CapReached));
+    }
+}
