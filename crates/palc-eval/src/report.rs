@@ -62,7 +62,7 @@ pub fn render(input: &ReportInput) -> String {
     }
     claims_section(&mut out);
     refusals(&mut out, input.rows);
-    learning_failures(&mut out, input.rows);
+    learning_failures(&mut out, input);
     timing_section(&mut out, input);
     example_section(&mut out, input);
     let _ = writeln!(out, "## Figures\n");
@@ -304,35 +304,77 @@ fn refusals(out: &mut String, rows: &[RunRow]) {
     let _ = writeln!(out);
 }
 
-fn learning_failures(out: &mut String, rows: &[RunRow]) {
-    let failures: Vec<(&RunRow, usize, &str)> = rows
-        .iter()
-        .flat_map(|row| {
-            (row.iterations.iter().enumerate())
-                .filter_map(move |(i, it)| Some((row, i, it.learning_error.as_deref()?)))
-        })
-        .collect();
+/// Lessons the method could not learn from, per method: how many, in how many
+/// runs, and their causes grouped by kind (the message up to its details, such
+/// as the steps of an infeasible plan), each with one full example.
+fn learning_failures(out: &mut String, input: &ReportInput) {
     let _ = writeln!(out, "## Lessons that could not be learned\n");
     let _ = writeln!(
         out,
-        "{} lessons in {} runs left the experience unchanged (the next lane change repeats the plan, \
-         and the cap counts it).\n",
-        failures.len(),
-        rows.iter()
-            .filter(|r| r.iterations.iter().any(|it| it.learning_error.is_some()))
-            .count()
+        "A lesson that cannot be learned leaves the experience unchanged: the next lane change \
+         repeats the plan, and the cap counts it.\n"
     );
-    let mut reasons: Vec<(&str, usize)> = Vec::new();
-    for (_, _, error) in &failures {
-        match reasons.iter_mut().find(|(r, _)| r == error) {
-            Some((_, n)) => *n += 1,
-            None => reasons.push((error, 1)),
+    let _ = writeln!(
+        out,
+        "| method | lessons not learned | of takeovers | runs with one |"
+    );
+    let _ = writeln!(out, "| --- | --- | --- | --- |");
+    let mut causes: Vec<(Method, &str, usize, &str)> = Vec::new();
+    for &method in input.methods {
+        let rows: Vec<&RunRow> = input
+            .rows
+            .iter()
+            .filter(|r| r.spec.method == method)
+            .collect();
+        let errors: Vec<&str> = (rows.iter())
+            .flat_map(|r| {
+                r.iterations
+                    .iter()
+                    .filter_map(|it| it.learning_error.as_deref())
+            })
+            .collect();
+        let takeovers: usize = (rows.iter())
+            .map(|r| r.iterations.iter().filter(|it| it.takeover).count())
+            .sum();
+        let runs = (rows.iter())
+            .filter(|r| r.iterations.iter().any(|it| it.learning_error.is_some()))
+            .count();
+        let _ = writeln!(
+            out,
+            "| {} | {} | {takeovers} | {runs} of {} |",
+            method.name(),
+            errors.len(),
+            rows.len()
+        );
+        for error in errors {
+            let kind = cause_kind(error);
+            match causes
+                .iter_mut()
+                .find(|(m, k, ..)| *m == method && *k == kind)
+            {
+                Some((_, _, n, _)) => *n += 1,
+                None => causes.push((method, kind, 1, error)),
+            }
         }
     }
-    for (reason, n) in reasons {
-        let _ = writeln!(out, "- {n} lessons: {reason}");
+    let _ = writeln!(out);
+    for (method, kind, n, example) in causes {
+        let _ = writeln!(
+            out,
+            "- `{}`, {n} lessons: {kind} (e.g. \"{example}\")",
+            method.name()
+        );
     }
     let _ = writeln!(out);
+}
+
+/// The kind of a learning error: its first two clauses (`what failed: why`),
+/// without the details that follow.
+fn cause_kind(error: &str) -> &str {
+    match error.match_indices(": ").nth(1) {
+        Some((end, _)) => &error[..end],
+        None => error,
+    }
 }
 
 fn timing_section(out: &mut String, input: &ReportInput) {
@@ -461,6 +503,15 @@ fn manifest_section(out: &mut String, m: &Manifest) {
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn a_learning_error_is_grouped_by_its_first_two_clauses() {
+        assert_eq!(
+            super::cause_kind("expert could not be planned: problem is infeasible: steps 3..=4"),
+            "expert could not be planned: problem is infeasible"
+        );
+        assert_eq!(super::cause_kind("zone: bad"), "zone: bad");
+    }
+
     use super::*;
     use crate::runner::tests::synthetic_rows;
 
@@ -509,5 +560,10 @@ mod tests {
         assert!(report.contains(&format!("{refused} of {} runs were refused", rows.len())));
         assert!(report.contains("**This is the `--quick` subset**"));
         assert!(report.contains("| aggressive |"));
+        assert!(report.contains("## Lessons that could not be learned"));
+        assert!(report.contains("## How each claim is measured"));
+        // One paragraph after the run count, no stray line break or leading space.
+        assert!(report.contains("grid runs per method. Deterministic users are the paper's set-up.\n"));
+        assert!(!report.contains("\n "), "a line starts with a space");
     }
 }
