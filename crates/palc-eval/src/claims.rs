@@ -80,6 +80,26 @@ pub enum Rule {
     AllAtOne,
 }
 
+impl Rule {
+    /// The rule in words, for the report.
+    pub fn describe(&self) -> String {
+        match *self {
+            Rule::Relative(v) => format!(
+                "relative difference to {v} (equal within {:.1} %)",
+                EQUAL_WITHIN * 100.0
+            ),
+            Rule::AllPersonalize => "holds when every counted run personalizes".to_owned(),
+            Rule::Range { min, max } => format!("holds when fewest and most lie in [{min}, {max}]"),
+            Rule::Direction => format!(
+                "holds when the first needs fewer takeovers; means within {TREND_RESOLUTION} are no difference"
+            ),
+            Rule::Points(v) => format!("difference to {:.0} % in percentage points", v * 100.0),
+            Rule::Below(v) => format!("holds when below {v} s"),
+            Rule::AllAtOne => "holds when every personalized run ends at ratio 1".to_owned(),
+        }
+    }
+}
+
 /// Relative differences below this are reported as `equal`.
 pub const EQUAL_WITHIN: f64 = 0.005;
 
