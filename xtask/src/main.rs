@@ -50,7 +50,6 @@ fn reproduce_paper(args: impl Iterator<Item = String>) -> anyhow::Result<()> {
         .args([
             "run",
             "--release",
-            "--quiet",
             "--package",
             "palc-cli",
             "--bin",
