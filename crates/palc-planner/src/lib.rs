@@ -67,7 +67,9 @@ mod riccati;
 mod validate;
 mod weights;
 
-pub use config::{Backend, LateralBoundsMode, PlannerConfig, SolverSettings};
+pub use config::{
+    Backend, LateralBoundsMode, MAX_ITER_RANGE, PlannerConfig, SolverSettings, TOLERANCE_RANGE,
+};
 pub use convexity::check_convexity;
 pub use error::{ConfigError, PlanError, StepRanges};
 pub use features::{features, stage_features};
