@@ -349,3 +349,33 @@ fn solver_settings_outside_their_documented_ranges_are_refused() {
         assert!(Planner::new(with(solver)).is_ok());
     }
 }
+
+#[test]
+fn positions_beyond_the_representable_range_are_refused() {
+    // Issue 12, item 4: at 1e15 m the planner reported "solved" with objective -3.5e13.
+    let config = config(30, LateralBoundsMode::Soft { weight: 100.0 });
+    let mut problem = lane_change(&config, 20.0);
+    for p in problem
+        .preceding
+        .iter_mut()
+        .chain(problem.adjacent.iter_mut())
+    {
+        p.s += 1e15;
+    }
+    problem.initial.s += 1e15;
+    let err = Planner::new(config.clone())
+        .unwrap()
+        .plan(&problem)
+        .unwrap_err();
+    assert!(
+        matches!(&err, PlanError::OutOfRange { field, .. } if field == "initial.s"),
+        "{err}"
+    );
+    let mut problem = lane_change(&config, 20.0);
+    problem.adjacent[7].s = -2e9;
+    let err = Planner::new(config).unwrap().plan(&problem).unwrap_err();
+    assert!(
+        matches!(&err, PlanError::OutOfRange { field, .. } if field == "adjacent[7].s"),
+        "{err}"
+    );
+}
