@@ -5,7 +5,7 @@
 //! the paper, and converted to SI when a scene is built.
 
 use crate::error::ConfigError;
-use crate::idm::IdmParams;
+use crate::idm::{DesiredGap, IdmParams};
 use crate::road::Road;
 use serde::{Deserialize, Serialize};
 
@@ -91,6 +91,9 @@ pub struct IdmConfig {
     /// Test bed only: desired speed of target-lane followers as a multiple of the background
     /// speed, above 1 so that a finite gap can hold the background speed.
     pub desired_speed_ratio: f64,
+    /// The form of the desired gap `s*`: `"clamped"` (default, SUMO's convention, used by
+    /// the test bed) or `"treiber2000"` (the formula as printed); see [`DesiredGap`].
+    pub desired_gap: DesiredGap,
 }
 
 impl Default for IdmConfig {
@@ -104,6 +107,7 @@ impl Default for IdmConfig {
             delta: p.delta,
             max_braking_mps2: 9.0,
             desired_speed_ratio: 1.2,
+            desired_gap: DesiredGap::Clamped,
         }
     }
 }
@@ -118,6 +122,7 @@ impl IdmConfig {
             a: self.a_mps2,
             b: self.b_mps2,
             delta: self.delta,
+            desired_gap: self.desired_gap,
         }
     }
 }
