@@ -199,6 +199,22 @@ pub struct PlatoonConfig {
     pub desired_speed_mph: f64,
     /// The leader's speed profile: piecewise linear between points, constant outside.
     pub leader_profile: Vec<ProfilePointConfig>,
+    /// Per-follower initial states, front to back (`[[platoon.followers]]`): empty (the
+    /// default) places every follower `headway_m` behind the vehicle ahead at
+    /// `initial_speed_mph`; otherwise exactly `vehicles - 1` entries, each overriding both,
+    /// so that a platoon can start away from equilibrium.
+    #[serde(default)]
+    pub followers: Vec<FollowerConfig>,
+}
+
+/// The initial state of one platoon follower.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FollowerConfig {
+    /// Front-to-front headway to the vehicle ahead at the start (m), positive.
+    pub headway_m: f64,
+    /// Initial speed (mph), at most the platoon's `desired_speed_mph`.
+    pub speed_mph: f64,
 }
 
 /// One point of a scripted speed profile.

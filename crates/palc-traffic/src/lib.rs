@@ -44,8 +44,8 @@ pub mod units;
 mod vehicle;
 
 pub use config::{
-    IdmConfig, MAX_SPEED_MPH, PlatoonConfig, ProfilePointConfig, RoadConfig, ScenarioConfig,
-    SpeedCaseConfig, TestbedConfig, VehicleConfig,
+    FollowerConfig, IdmConfig, MAX_SPEED_MPH, PlatoonConfig, ProfilePointConfig, RoadConfig,
+    ScenarioConfig, SpeedCaseConfig, TestbedConfig, VehicleConfig,
 };
 pub use error::{ConfigError, SceneError};
 pub use idm::{BallisticStep, DesiredGap, IdmParams, MIN_INTERACTION_GAP, ballistic_step};
