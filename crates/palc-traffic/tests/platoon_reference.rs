@@ -30,8 +30,8 @@ fn config(form: &str, followers: &[(f64, f64)]) -> String {
 
 /// `s*` and the IDM acceleration as printed, computed here independently.
 fn idm(v: f64, gap: f64, dv: f64, clamped: bool) -> f64 {
-    let (v0, t, s0, a, b) = (65.0 * MPH, 1.6, 2.0, 0.73, 1.67);
-    let mut dynamic = v * t + v * dv / (2.0 * (a * b as f64).sqrt());
+    let (v0, t, s0, a, b): (f64, f64, f64, f64, f64) = (65.0 * MPH, 1.6, 2.0, 0.73, 1.67);
+    let mut dynamic = v * t + v * dv / (2.0 * (a * b).sqrt());
     if clamped {
         dynamic = dynamic.max(0.0);
     }
