@@ -112,3 +112,42 @@ fn a_bad_config_fails_with_the_file_and_field_named() {
     assert!(!output.status.success());
     assert!(String::from_utf8_lossy(&output.stderr).contains("--dt"));
 }
+
+#[test]
+fn values_are_written_in_full_precision_and_json_matches_csv() {
+    // Issue 12, item 2: four decimals (5e-5 rounding) could not be compared at 1e-6.
+    let args = ["--duration", "3", "--dt", "0.1"];
+    let output = simulate("configs/platoon.toml", &args, "precision.csv");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let rows = read_rows("precision.csv");
+    let decimals = |text: &str| text.split('.').nth(1).map_or(0, str::len);
+    assert!(
+        rows.iter().any(|r| decimals(&r[3]) > 4),
+        "positions are still rounded"
+    );
+    let mut json_args = args.to_vec();
+    json_args.extend(["--format", "json"]);
+    let output = simulate("configs/platoon.toml", &json_args, "precision.json");
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let path = Path::new(env!("CARGO_TARGET_TMPDIR")).join("precision.json");
+    let json: Vec<serde_json::Value> =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    assert_eq!(json.len(), rows.len());
+    for (row, object) in rows.iter().zip(&json) {
+        for (i, key) in ["time", "id", "lane", "s", "l", "v", "a"]
+            .iter()
+            .enumerate()
+        {
+            // Both are the shortest round-trip forms of the same f64: equal bit for bit.
+            assert_eq!(field(row, i), object[key].as_f64().unwrap(), "{key}");
+        }
+    }
+}

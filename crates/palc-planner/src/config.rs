@@ -46,16 +46,19 @@ pub enum Backend {
 /// Settings passed to the QP solver; the defaults were chosen by measurement
 /// (see the crate documentation and docs/paper-mapping.md). Both backends read
 /// `max_iter` and the three tolerances; the last three fields are clarabel's.
+///
+/// [`PlannerConfig::validate`] holds every number to a documented range:
+/// `max_iter` in [`MAX_ITER_RANGE`], each tolerance in [`TOLERANCE_RANGE`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SolverSettings {
-    /// Maximum interior-point iterations.
+    /// Maximum interior-point iterations, in [`MAX_ITER_RANGE`].
     pub max_iter: u32,
-    /// Absolute duality-gap tolerance.
+    /// Absolute duality-gap tolerance, in [`TOLERANCE_RANGE`].
     pub tol_gap_abs: f64,
-    /// Relative duality-gap tolerance.
+    /// Relative duality-gap tolerance, in [`TOLERANCE_RANGE`].
     pub tol_gap_rel: f64,
-    /// Primal and dual feasibility tolerance.
+    /// Primal and dual feasibility tolerance, in [`TOLERANCE_RANGE`].
     pub tol_feas: f64,
     /// Ruiz equilibration of the problem data when the solver is built (kept while the
     /// structure is reused). On by default: without it the optimum is measurably less
@@ -69,6 +72,18 @@ pub struct SolverSettings {
     /// sparsity pattern and only overwrite the values.
     pub reuse_structure: bool,
 }
+
+/// Allowed `max_iter`: at least one iteration; at most 10 000, a hundred times the
+/// default and far beyond the 10-40 iterations both backends take on the lane
+/// changes of the test suite, so that a runaway setting cannot stall a plan.
+pub const MAX_ITER_RANGE: std::ops::RangeInclusive<u32> = 1..=10_000;
+
+/// Allowed solver tolerances. Below 1e-14 a relative test asks for less than
+/// about 50 ulp of the objective, which neither backend reaches in double
+/// precision (they stop at `MaxIterations`); above 1e-2 a "solved" plan may be
+/// 1 % off its optimum, and a tolerance of 1e308 would report "solved" after 0
+/// iterations.
+pub const TOLERANCE_RANGE: std::ops::RangeInclusive<f64> = 1e-14..=1e-2;
 
 impl Default for SolverSettings {
     fn default() -> Self {
@@ -187,19 +202,23 @@ impl PlannerConfig {
             )?;
         }
         let s = &self.solver;
-        if s.max_iter == 0 {
-            return Err(ConfigError::OutOfRange {
-                field: "solver.max_iter",
-                value: 0.0,
-                bound: "at least 1",
-            });
-        }
+        check(
+            "solver.max_iter",
+            f64::from(s.max_iter),
+            MAX_ITER_RANGE.contains(&s.max_iter),
+            "an integer in [1, 10000]",
+        )?;
         for (field, value) in [
             ("solver.tol_gap_abs", s.tol_gap_abs),
             ("solver.tol_gap_rel", s.tol_gap_rel),
             ("solver.tol_feas", s.tol_feas),
         ] {
-            check(field, value, value.is_finite() && value > 0.0, positive)?;
+            check(
+                field,
+                value,
+                TOLERANCE_RANGE.contains(&value),
+                "in [1e-14, 1e-2]",
+            )?;
         }
         Ok(())
     }

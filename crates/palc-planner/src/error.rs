@@ -10,7 +10,7 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum ConfigError {
     /// A field lies outside its allowed range.
-    #[error("config field `{field}` = {value} is out of range: must be {bound}")]
+    #[error("config field `{field}` = {value:e} is out of range: must be {bound}")]
     OutOfRange {
         /// The field, e.g. `dt`.
         field: &'static str,

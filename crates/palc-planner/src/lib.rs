@@ -67,10 +67,14 @@ mod riccati;
 mod validate;
 mod weights;
 
-pub use config::{Backend, LateralBoundsMode, PlannerConfig, SolverSettings};
+pub use config::{
+    Backend, LateralBoundsMode, MAX_ITER_RANGE, PlannerConfig, SolverSettings, TOLERANCE_RANGE,
+};
 pub use convexity::check_convexity;
 pub use error::{ConfigError, PlanError, StepRanges};
 pub use features::{features, stage_features};
 pub use planner::{Extras, Plan, Planner, SolveStats, SolveStatus};
-pub use problem::{Control, LateralBound, Position, Problem, State, Terminal, Tracking};
+pub use problem::{
+    Control, LateralBound, MAX_POSITION, Position, Problem, State, Terminal, Tracking,
+};
 pub use weights::{FEATURE_COUNT, Features, Weights, feature};

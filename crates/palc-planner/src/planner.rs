@@ -143,7 +143,7 @@ impl Planner {
         let states: Vec<State> = (0..=k)
             .map(|i| {
                 let o = state_index(i);
-                State::from_array([x[o], x[o + 1], x[o + 2], x[o + 3]])
+                State::from_array([x[o] + self.data.origin, x[o + 1], x[o + 2], x[o + 3]])
             })
             .collect();
         let controls: Vec<Control> = (0..k)

@@ -102,11 +102,21 @@ pub struct Tracking {
     pub reference: Vec<Option<State>>,
 }
 
+/// The largest `|s|` (m) a [`Problem`] may hold (initial, predicted, terminal and
+/// tracking positions); beyond it the planner refuses with
+/// [`PlanError::OutOfRange`](crate::PlanError::OutOfRange). The QP is built relative to
+/// `initial.s`, so the optimum does not depend on the origin up to this bound (property
+/// test); at 1e9 m a double still resolves 1.2e-7 m, and beyond it the input positions
+/// themselves lose the resolution that the relative offsets need (0.125 m at 1e15 m,
+/// where the planner used to report "solved" with an objective of -3.5e13).
+pub const MAX_POSITION: f64 = 1e9;
+
 /// One planning problem for a horizon of `K` steps.
 ///
 /// Pass `s` relative to the ego's position at the start of the plan (`initial.s = 0`,
 /// other vehicles shifted by the same amount): the feature `s δ` (w7) then does not
-/// depend on where on the road the plan begins. The planner itself takes `s` as given.
+/// depend on where on the road the plan begins. The planner itself takes `s` as given,
+/// assembles its QP relative to `initial.s` and refuses `|s| >` [`MAX_POSITION`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Problem {

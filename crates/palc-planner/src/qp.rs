@@ -5,6 +5,14 @@
 //! per bounded step in soft mode. Every entry of the sparsity pattern is always written
 //! (zeros included), so the pattern depends only on `K`, the bound pattern, the mode and
 //! whether `s_K` is fixed.
+//!
+//! Longitudinal positions are assembled relative to the ego's initial position,
+//! `s̃ = s - s_0` (the variable of `z` is `s̃`, [`QpData::origin`] holds `s_0`): the
+//! squared distances of Eq. 34 and the tracking term then expand around offsets of
+//! tens of metres instead of absolute positions, whose squares (1e18 at 1e9 m) would
+//! cancel in the objective. The feature `s δ` (w7) is kept exact as
+//! `w7 s̃ δ + w7 s_0 δ`, a linear term in `δ`: it is the one feature that depends on
+//! where the plan starts (see [`Problem`]).
 
 use crate::{LateralBoundsMode, PlannerConfig, Problem, feature};
 
@@ -52,6 +60,8 @@ pub(crate) struct QpData {
     pub b: Vec<f64>,
     /// Constant dropped from the quadratic form (squared-distance and tracking constants).
     pub constant: f64,
+    /// `s_0`: the longitudinal variables of `z` are `s - s_0`.
+    pub origin: f64,
     /// Tag of each inequality row (index `row - m_eq`).
     pub row_tags: Vec<RowTag>,
     /// Slack variable of each step in soft mode.
@@ -103,12 +113,16 @@ impl QpData {
         self.q.clear();
         self.q.resize(n, 0.0);
         self.constant = 0.0;
+        let origin = problem.initial.s;
+        self.origin = origin;
 
         // Eq. (15) with Eqs. (16)-(19), stage i uses X_{i-1}, U_{i-1} and column i-1.
         for (stage0, w) in problem.weights.columns().iter().enumerate() {
             let x = state_index(stage0);
             let u = control_index(stage0);
-            let (pre, adj) = (problem.preceding[stage0], problem.adjacent[stage0]);
+            let (mut pre, mut adj) = (problem.preceding[stage0], problem.adjacent[stage0]);
+            pre.s -= origin;
+            adj.s -= origin;
             let (w9, w10) = (w[feature::DIST_PRECEDING], w[feature::DIST_ADJACENT]);
             self.p(x, x, 2.0 * (w9 + w10));
             self.p(x + 2, x + 2, 2.0 * (w[feature::L_SQUARED] + w9 + w10));
@@ -121,6 +135,7 @@ impl QpData {
             self.q[x] += -2.0 * (w9 * pre.s + w10 * adj.s);
             self.q[x + 2] += w[feature::L] - 2.0 * (w9 * pre.l + w10 * adj.l);
             self.q[x + 3] += w[feature::PHI];
+            self.q[u + 1] += w[feature::S_DELTA] * origin;
             self.constant +=
                 w9 * (pre.s * pre.s + pre.l * pre.l) + w10 * (adj.s * adj.s + adj.l * adj.l);
         }
@@ -130,7 +145,11 @@ impl QpData {
             let reference = problem
                 .tracking
                 .as_ref()
-                .and_then(|t| t.reference[step].map(|r| (t.weights, r.to_array())));
+                .and_then(|t| t.reference[step].map(|r| (t.weights, r.to_array())))
+                .map(|(q, mut r)| {
+                    r[0] -= origin;
+                    (q, r)
+                });
             for c in 0..4 {
                 let (weight, r) = reference.map_or((0.0, 0.0), |(q, r)| (q[c], r[c]));
                 self.p(x + c, x + c, 2.0 * weight);
@@ -146,7 +165,8 @@ impl QpData {
 
         // Equality rows: X_0 (Eq. 20), dynamics (Eqs. 11-14), terminal (Eq. 21).
         self.b.clear();
-        let x0 = problem.initial.to_array();
+        let mut x0 = problem.initial.to_array();
+        x0[0] = 0.0;
         for c in 0..4 {
             self.a(c, c, 1.0);
             self.b.push(x0[c]);
@@ -170,7 +190,12 @@ impl QpData {
         let mut r = 4 + 4 * k;
         let xk = state_index(k);
         let t = &problem.terminal;
-        let terminal = [(t.s, 0), (Some(t.v), 1), (Some(t.l), 2), (Some(0.0), 3)];
+        let terminal = [
+            (t.s.map(|s| s - origin), 0),
+            (Some(t.v), 1),
+            (Some(t.l), 2),
+            (Some(0.0), 3),
+        ];
         for (value, c) in terminal {
             if let Some(value) = value {
                 self.a(r, xk + c, 1.0);

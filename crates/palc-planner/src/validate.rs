@@ -1,6 +1,8 @@
 //! Checks of a [`Problem`] against a [`PlannerConfig`] before any QP is built.
 
-use crate::{LateralBoundsMode, PlanError, PlannerConfig, Problem, StepRanges, check_convexity};
+use crate::{
+    LateralBoundsMode, MAX_POSITION, PlanError, PlannerConfig, Problem, StepRanges, check_convexity,
+};
 
 fn finite(field: impl FnOnce() -> String, value: f64) -> Result<(), PlanError> {
     if value.is_finite() {
@@ -101,10 +103,46 @@ pub(crate) fn validate_problem(config: &PlannerConfig, problem: &Problem) -> Res
         }
     }
 
+    check_positions(problem)?;
     check_convexity(&problem.weights)?;
 
     if config.lateral_bounds_mode == LateralBoundsMode::Hard {
         check_hard_bounds(k, problem)?;
+    }
+    Ok(())
+}
+
+/// Every longitudinal position within [`MAX_POSITION`] of the origin.
+fn check_positions(problem: &Problem) -> Result<(), PlanError> {
+    let check = |field: &dyn Fn() -> String, s: f64| {
+        if s.abs() <= MAX_POSITION {
+            Ok(())
+        } else {
+            Err(PlanError::OutOfRange {
+                field: field(),
+                value: s,
+                bound: "within 1e9 m of the origin (pass s relative to the ego)",
+            })
+        }
+    };
+    check(&|| "initial.s".into(), problem.initial.s)?;
+    for (name, positions) in [
+        ("preceding", &problem.preceding),
+        ("adjacent", &problem.adjacent),
+    ] {
+        for (i, p) in positions.iter().enumerate() {
+            check(&|| format!("{name}[{i}].s"), p.s)?;
+        }
+    }
+    if let Some(s) = problem.terminal.s {
+        check(&|| "terminal.s".into(), s)?;
+    }
+    if let Some(tracking) = &problem.tracking {
+        for (i, r) in tracking.reference.iter().enumerate() {
+            if let Some(r) = r {
+                check(&|| format!("tracking.reference[{i}].s"), r.s)?;
+            }
+        }
     }
     Ok(())
 }

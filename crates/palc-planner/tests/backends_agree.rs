@@ -12,7 +12,7 @@ mod common;
 use common::{convex_column, convex_problem, lane_change};
 use palc_planner::{
     Backend, LateralBound, LateralBoundsMode, Plan, PlanError, Planner, PlannerConfig, Problem,
-    SolverSettings, State, Tracking, Weights,
+    SolverSettings, State, Tracking, Weights, check_convexity,
 };
 use proptest::prelude::*;
 
@@ -134,6 +134,14 @@ fn zone_problem() -> impl Strategy<Value = (PlannerConfig, Problem)> {
         })
 }
 
+/// Cases per property: 64 in CI, `PROPTEST_CASES` for a larger local budget.
+fn cases() -> u32 {
+    std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(64)
+}
+
 /// The trajectory tolerance of the module docs, `[s, v, l, φ, a, δ]`.
 const TRAJECTORY_TOLERANCE: [f64; 6] = [1e-3; 6];
 
@@ -141,7 +149,7 @@ proptest! {
     #![proptest_config(ProptestConfig {
         rng_seed: proptest::test_runner::RngSeed::Fixed(20261123),
         failure_persistence: None,
-        ..ProptestConfig::with_cases(64)
+        ..ProptestConfig::with_cases(cases())
     })]
 
     #[test]
@@ -360,6 +368,104 @@ fn both_backends_agree_on_the_shortest_horizons() {
                     panic!("K = {k}, l_K = {target}: riccati {riccati:?} vs clarabel {clarabel:?}")
                 }
             }
+        }
+    }
+}
+
+/// The lane change of issue 12, item 3: a curved road, no acceleration penalty, no
+/// `s`-coupling (w7 = w9 = w10 = 0) and a fixed terminal `s`, so the acceleration
+/// enters the cost nowhere, the longitudinal subproblem is a pure feasibility problem
+/// and the optimum is not unique.
+fn singular_lane_change(
+    horizon: usize,
+    speed: f64,
+    curvature: f64,
+    column: [f64; 10],
+) -> (PlannerConfig, Problem) {
+    let config = PlannerConfig {
+        horizon,
+        acceleration_penalty: 0.0,
+        ..PlannerConfig::default()
+    };
+    let mut problem = lane_change(&config, speed);
+    problem.curvature = curvature;
+    problem.weights = Weights::constant(horizon, column);
+    problem.terminal.s = Some(speed * horizon as f64 * config.dt + 5.0);
+    (config, problem)
+}
+
+#[test]
+fn riccati_solves_a_curved_lane_change_without_acceleration_penalty_and_fixed_terminal_s() {
+    // Before the terminal Schur complement was regularized row by row, 188 of 384 such
+    // problems (K in 20-80, three speeds, four curvatures, four terminal s) ended at
+    // `MaxIterations`, a non-positive control block or an objective 4e-5 off.
+    for (k, speed, curvature) in [(40, 12.0, 0.002), (40, 20.1168, -0.002), (60, 12.0, 0.002)] {
+        let column = [0.01, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 200.0, 0.0, 0.0];
+        let (config, problem) = singular_lane_change(k, speed, curvature, column);
+        let clarabel = plan_with(Backend::Clarabel, &reference_config(&config), &problem).unwrap();
+        let riccati = plan_with(Backend::Riccati, &config, &problem).unwrap();
+        let scale = 1.0 + clarabel.objective.abs();
+        assert!(
+            (riccati.objective - clarabel.objective).abs() <= 1e-6 * scale,
+            "K = {k}, v = {speed}, R = {curvature}: riccati {} vs clarabel {}",
+            riccati.objective,
+            clarabel.objective
+        );
+    }
+}
+
+/// Problems with singular Hessian directions: `convex_problem` without an acceleration
+/// penalty, on a curved road, with a fixed terminal `s` and no `s`-coupling at all
+/// (w7 = w9 = w10 = 0, w5 scaled down so that each stage block stays positive
+/// semidefinite), so that the acceleration has no curvature in any direction.
+fn singular_problem() -> impl Strategy<Value = (PlannerConfig, Problem)> {
+    (convex_problem(), -0.01..0.01f64, -0.3..0.3f64).prop_map(
+        |((config, mut problem), curvature, offset)| {
+            let config = PlannerConfig {
+                acceleration_penalty: 0.0,
+                ..config
+            };
+            problem.curvature = curvature;
+            for column in problem.weights.columns_mut() {
+                let (w1, w9, w10) = (column[0], column[8], column[9]);
+                if w1 + w9 + w10 > 0.0 {
+                    column[4] *= (w1 / (w1 + w9 + w10)).sqrt();
+                }
+                column[6] = 0.0;
+                column[8] = 0.0;
+                column[9] = 0.0;
+            }
+            let duration = config.horizon as f64 * config.dt;
+            let speed = problem.initial.v;
+            problem.terminal.s = Some(speed * duration + offset * duration * duration);
+            (config, problem)
+        },
+    )
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        rng_seed: proptest::test_runner::RngSeed::Fixed(20261201),
+        failure_persistence: None,
+        ..ProptestConfig::with_cases(cases())
+    })]
+
+    /// Non-unique optima: both backends solve and reach the same objective.
+    #[test]
+    fn both_backends_agree_on_singular_hessians((config, problem) in singular_problem()) {
+        prop_assert!(check_convexity(&problem.weights).is_ok());
+        let riccati = plan_with(Backend::Riccati, &config, &problem);
+        let clarabel = plan_with(Backend::Clarabel, &reference_config(&config), &problem);
+        match (&riccati, &clarabel) {
+            (Ok(r), Ok(c)) => {
+                let scale = 1.0 + c.objective.abs();
+                prop_assert!(
+                    (r.objective - c.objective).abs() <= 1e-6 * scale,
+                    "objective riccati {} vs clarabel {}", r.objective, c.objective
+                );
+            }
+            (Err(PlanError::Infeasible { .. }), Err(PlanError::Infeasible { .. })) => {}
+            _ => prop_assert!(false, "riccati {:?} vs clarabel {:?}", riccati.map(|p| p.objective), clarabel.map(|p| p.objective)),
         }
     }
 }

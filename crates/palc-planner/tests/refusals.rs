@@ -4,8 +4,8 @@ mod common;
 
 use common::lane_change;
 use palc_planner::{
-    ConfigError, LateralBound, LateralBoundsMode, PlanError, Planner, PlannerConfig, StepRanges,
-    Tracking, check_convexity,
+    ConfigError, LateralBound, LateralBoundsMode, MAX_ITER_RANGE, PlanError, Planner,
+    PlannerConfig, SolverSettings, StepRanges, TOLERANCE_RANGE, Tracking, check_convexity,
 };
 use proptest::prelude::*;
 
@@ -261,4 +261,121 @@ fn step_ranges_print_compactly() {
     let r = StepRanges::from_steps([1, 2, 3, 7, 9, 10]);
     assert_eq!(r.to_string(), "1..=3, 7, 9..=10");
     assert_eq!(StepRanges::default().to_string(), "none");
+}
+
+#[test]
+fn solver_settings_outside_their_documented_ranges_are_refused() {
+    // Issue 12, item 5: a tolerance of 1e308 used to report "solved" after 0 iterations.
+    let with = |solver: SolverSettings| PlannerConfig {
+        solver,
+        ..PlannerConfig::default()
+    };
+    let defaults = SolverSettings::default();
+    let cases = [
+        (
+            "solver.tol_gap_abs",
+            SolverSettings {
+                tol_gap_abs: 1e308,
+                ..defaults.clone()
+            },
+        ),
+        (
+            "solver.tol_gap_rel",
+            SolverSettings {
+                tol_gap_rel: 0.5,
+                ..defaults.clone()
+            },
+        ),
+        (
+            "solver.tol_feas",
+            SolverSettings {
+                tol_feas: 1e-300,
+                ..defaults.clone()
+            },
+        ),
+        (
+            "solver.tol_feas",
+            SolverSettings {
+                tol_feas: f64::NAN,
+                ..defaults.clone()
+            },
+        ),
+        (
+            "solver.max_iter",
+            SolverSettings {
+                max_iter: 0,
+                ..defaults.clone()
+            },
+        ),
+        (
+            "solver.max_iter",
+            SolverSettings {
+                max_iter: 1_000_000,
+                ..defaults.clone()
+            },
+        ),
+    ];
+    for (field, solver) in cases {
+        let err = Planner::new(with(solver)).unwrap_err();
+        assert!(
+            matches!(err, PlanError::Config(ConfigError::OutOfRange { field: f, .. }) if f == field),
+            "{field}: {err}"
+        );
+        assert!(err.to_string().contains(field), "{err}");
+    }
+    assert_eq!(
+        Planner::new(with(SolverSettings {
+            tol_gap_abs: 1e308,
+            ..defaults.clone()
+        }))
+        .unwrap_err()
+        .to_string(),
+        "config field `solver.tol_gap_abs` = 1e308 is out of range: must be in [1e-14, 1e-2]"
+    );
+    // The ends of the ranges are accepted.
+    for solver in [
+        SolverSettings {
+            max_iter: *MAX_ITER_RANGE.end(),
+            tol_gap_abs: *TOLERANCE_RANGE.start(),
+            tol_gap_rel: *TOLERANCE_RANGE.end(),
+            tol_feas: *TOLERANCE_RANGE.start(),
+            ..defaults.clone()
+        },
+        SolverSettings {
+            max_iter: *MAX_ITER_RANGE.start(),
+            ..defaults.clone()
+        },
+    ] {
+        assert!(Planner::new(with(solver)).is_ok());
+    }
+}
+
+#[test]
+fn positions_beyond_the_representable_range_are_refused() {
+    // Issue 12, item 4: at 1e15 m the planner reported "solved" with objective -3.5e13.
+    let config = config(30, LateralBoundsMode::Soft { weight: 100.0 });
+    let mut problem = lane_change(&config, 20.0);
+    for p in problem
+        .preceding
+        .iter_mut()
+        .chain(problem.adjacent.iter_mut())
+    {
+        p.s += 1e15;
+    }
+    problem.initial.s += 1e15;
+    let err = Planner::new(config.clone())
+        .unwrap()
+        .plan(&problem)
+        .unwrap_err();
+    assert!(
+        matches!(&err, PlanError::OutOfRange { field, .. } if field == "initial.s"),
+        "{err}"
+    );
+    let mut problem = lane_change(&config, 20.0);
+    problem.adjacent[7].s = -2e9;
+    let err = Planner::new(config).unwrap().plan(&problem).unwrap_err();
+    assert!(
+        matches!(&err, PlanError::OutOfRange { field, .. } if field == "adjacent[7].s"),
+        "{err}"
+    );
 }

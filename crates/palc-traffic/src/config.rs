@@ -5,7 +5,7 @@
 //! the paper, and converted to SI when a scene is built.
 
 use crate::error::ConfigError;
-use crate::idm::IdmParams;
+use crate::idm::{DesiredGap, IdmParams};
 use crate::road::Road;
 use serde::{Deserialize, Serialize};
 
@@ -91,6 +91,9 @@ pub struct IdmConfig {
     /// Test bed only: desired speed of target-lane followers as a multiple of the background
     /// speed, above 1 so that a finite gap can hold the background speed.
     pub desired_speed_ratio: f64,
+    /// The form of the desired gap `s*`: `"clamped"` (default, SUMO's convention, used by
+    /// the test bed) or `"treiber2000"` (the formula as printed); see [`DesiredGap`].
+    pub desired_gap: DesiredGap,
 }
 
 impl Default for IdmConfig {
@@ -104,6 +107,7 @@ impl Default for IdmConfig {
             delta: p.delta,
             max_braking_mps2: 9.0,
             desired_speed_ratio: 1.2,
+            desired_gap: DesiredGap::Clamped,
         }
     }
 }
@@ -118,6 +122,7 @@ impl IdmConfig {
             a: self.a_mps2,
             b: self.b_mps2,
             delta: self.delta,
+            desired_gap: self.desired_gap,
         }
     }
 }
@@ -194,6 +199,22 @@ pub struct PlatoonConfig {
     pub desired_speed_mph: f64,
     /// The leader's speed profile: piecewise linear between points, constant outside.
     pub leader_profile: Vec<ProfilePointConfig>,
+    /// Per-follower initial states, front to back (`[[platoon.followers]]`): empty (the
+    /// default) places every follower `headway_m` behind the vehicle ahead at
+    /// `initial_speed_mph`; otherwise exactly `vehicles - 1` entries, each overriding both,
+    /// so that a platoon can start away from equilibrium.
+    #[serde(default)]
+    pub followers: Vec<FollowerConfig>,
+}
+
+/// The initial state of one platoon follower.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FollowerConfig {
+    /// Front-to-front headway to the vehicle ahead at the start (m), positive.
+    pub headway_m: f64,
+    /// Initial speed (mph), at most the platoon's `desired_speed_mph`.
+    pub speed_mph: f64,
 }
 
 /// One point of a scripted speed profile.

@@ -44,11 +44,11 @@ pub mod units;
 mod vehicle;
 
 pub use config::{
-    IdmConfig, MAX_SPEED_MPH, PlatoonConfig, ProfilePointConfig, RoadConfig, ScenarioConfig,
-    SpeedCaseConfig, TestbedConfig, VehicleConfig,
+    FollowerConfig, IdmConfig, MAX_SPEED_MPH, PlatoonConfig, ProfilePointConfig, RoadConfig,
+    ScenarioConfig, SpeedCaseConfig, TestbedConfig, VehicleConfig,
 };
 pub use error::{ConfigError, SceneError};
-pub use idm::{BallisticStep, IdmParams, MIN_INTERACTION_GAP, ballistic_step};
+pub use idm::{BallisticStep, DesiredGap, IdmParams, MIN_INTERACTION_GAP, ballistic_step};
 pub use prediction::{MAX_HORIZON_STEPS, Prediction, PredictionModel};
 pub use road::{Lane, Road};
 pub use scene::{MAX_DT, MAX_VEHICLES, Scene};

@@ -9,7 +9,7 @@ use crate::units::mph_to_mps;
 use crate::vehicle::{Driver, SpeedProfile, Vehicle, VehicleId, VehicleState};
 
 /// Builds the platoon scene: the leader (id 0) at `leader_start_s_m`, followers 1.. behind it
-/// at `headway_m` front to front, all on `lane`.
+/// at `headway_m` front to front (or each at its own `followers` entry), all on `lane`.
 pub(crate) fn build(config: &ScenarioConfig) -> Result<Scene, ConfigError> {
     let platoon = config.platoon.as_ref().ok_or(ConfigError::ScenarioKind {
         found: "no [platoon]",
@@ -83,10 +83,42 @@ pub(crate) fn build(config: &ScenarioConfig) -> Result<Scene, ConfigError> {
     let lane = Lane(platoon.lane);
     let l = road.lane_centre(lane);
     let (length, width) = (config.vehicle.length_m, config.vehicle.width_m);
+    // Per follower: (front-to-front headway to the vehicle ahead, initial speed).
+    let mut followers = Vec::with_capacity(count - 1);
+    if platoon.followers.is_empty() {
+        followers.resize(count - 1, (headway, v_init));
+    } else {
+        if platoon.followers.len() != count - 1 {
+            return Err(out_of_range(
+                "platoon.followers",
+                platoon.followers.len() as f64,
+                &format!("exactly platoon.vehicles - 1 = {} entries", count - 1),
+            ));
+        }
+        for (i, follower) in platoon.followers.iter().enumerate() {
+            let headway = positive(
+                &format!("platoon.followers[{i}].headway_m"),
+                follower.headway_m,
+            )?;
+            let field = format!("platoon.followers[{i}].speed_mph");
+            let v = mph_to_mps(speed_mph(&field, follower.speed_mph, true)?);
+            if v > v0 {
+                return Err(ConfigError::SpeedAboveDesired {
+                    field,
+                    speed_mps: v,
+                    v0_mps: v0,
+                });
+            }
+            followers.push((headway, v));
+        }
+    }
     let mut vehicles = Vec::with_capacity(count);
     let leader_v = profile.speed_at(0.0);
+    let mut s = leader_s;
     for i in 0..count {
-        let s = leader_s - i as f64 * headway;
+        if i > 0 {
+            s -= followers[i - 1].0;
+        }
         let id = VehicleId(i as u32);
         if s < 0.0 {
             return Err(ConfigError::OutsideSection {
@@ -99,7 +131,7 @@ pub(crate) fn build(config: &ScenarioConfig) -> Result<Scene, ConfigError> {
         let (v, driver) = if i == 0 {
             (leader_v, Driver::Scripted(profile.clone()))
         } else {
-            (v_init, Driver::Idm(config.idm.params(v0)))
+            (followers[i - 1].1, Driver::Idm(config.idm.params(v0)))
         };
         let state = VehicleState {
             s,

@@ -4,7 +4,9 @@
 mod common;
 
 use common::{net_gaps, platoon, road, vehicle};
-use palc_traffic::{Driver, IdmParams, Scene, SpeedProfile, ballistic_step};
+use palc_traffic::{
+    DesiredGap, Driver, IdmParams, ScenarioConfig, Scene, SpeedProfile, ballistic_step,
+};
 use proptest::prelude::*;
 
 fn idm_params() -> impl Strategy<Value = IdmParams> {
@@ -14,14 +16,16 @@ fn idm_params() -> impl Strategy<Value = IdmParams> {
         0.5..2.5f64,
         1.0..3.0f64,
         prop_oneof![Just(4.0), 1.0..6.0f64],
+        prop_oneof![Just(DesiredGap::Clamped), Just(DesiredGap::Treiber2000)],
     )
-        .prop_map(|(t, s0, a, b, delta)| IdmParams {
+        .prop_map(|(t, s0, a, b, delta, desired_gap)| IdmParams {
             v0: 1.0,
             t,
             s0,
             a,
             b,
             delta,
+            desired_gap,
         })
 }
 
@@ -167,4 +171,65 @@ fn a_stopped_vehicle_never_moves_backwards() {
         assert_eq!(scene.vehicles()[1].state.s, start);
         assert_eq!(scene.vehicles()[1].state.v, 0.0);
     }
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// At the equilibrium gap `s_e(v)` behind a leader at the same speed the IDM
+    /// acceleration is zero, for both forms of `s*` (issue 12, item 2).
+    #[test]
+    fn the_equilibrium_gap_has_zero_acceleration(
+        idm in idm_params(),
+        v0 in 5.0..40.0f64,
+        fraction in 0.0..0.95f64,
+    ) {
+        let idm = IdmParams { v0, ..idm };
+        let v = fraction * v0;
+        let gap = idm.equilibrium_gap(v).unwrap();
+        let acc = idm.acceleration(v, gap, 0.0);
+        prop_assert!(acc.abs() <= 1e-12 * idm.a.max(1.0), "{acc:e} at v = {v}, gap = {gap}");
+    }
+
+    /// The two forms of `s*` agree while the follower is not slower than its leader
+    /// and differ exactly by the clamp otherwise; `treiber2000` is the printed formula.
+    #[test]
+    fn the_two_desired_gaps_differ_only_by_the_clamp(
+        idm in idm_params(),
+        v in 0.0..40.0f64,
+        dv in -30.0..30.0f64,
+    ) {
+        let printed = IdmParams { desired_gap: DesiredGap::Treiber2000, ..idm };
+        let clamped = IdmParams { desired_gap: DesiredGap::Clamped, ..idm };
+        let dynamic = v * idm.t + v * dv / (2.0 * (idm.a * idm.b).sqrt());
+        prop_assert_eq!(printed.desired_gap(v, dv), idm.s0 + dynamic);
+        prop_assert_eq!(clamped.desired_gap(v, dv), idm.s0 + dynamic.max(0.0));
+        if dynamic >= 0.0 {
+            prop_assert_eq!(printed.desired_gap(v, dv), clamped.desired_gap(v, dv));
+        }
+    }
+}
+
+#[test]
+fn the_desired_gap_is_chosen_in_the_idm_table() {
+    let text = |form: &str| {
+        format!(
+            "[road]\nlength_m = 500.0\nlanes = 1\n[idm]\ndesired_gap = \"{form}\"\n\
+             [platoon]\nvehicles = 2\nlane = 0\nleader_start_s_m = 100.0\nheadway_m = 40.0\n\
+             initial_speed_mph = 20.0\ndesired_speed_mph = 60.0\n\
+             leader_profile = [{{ time_s = 0.0, speed_mph = 40.0 }}]\n"
+        )
+    };
+    for (form, expected) in [
+        ("treiber2000", DesiredGap::Treiber2000),
+        ("clamped", DesiredGap::Clamped),
+    ] {
+        let config = ScenarioConfig::from_toml_str(&text(form)).unwrap();
+        assert_eq!(config.idm.desired_gap, expected);
+    }
+    assert_eq!(
+        palc_traffic::IdmConfig::default().desired_gap,
+        DesiredGap::Clamped
+    );
+    assert!(ScenarioConfig::from_toml_str(&text("sumo")).is_err());
 }

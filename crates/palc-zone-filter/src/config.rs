@@ -27,8 +27,15 @@ pub struct ZoneConfig {
     pub discriminant: Discriminant,
     /// Ridge added to the covariance in standardized coordinates:
     /// `Sigma_reg = D (R + ridge I) D`, with `D` the per-feature scales and `R`
-    /// the correlation-like matrix. Scale-free; `>= 0`. Zero disables it (a
-    /// singular covariance is then an error).
+    /// the correlation-like matrix. Scale-free; finite and `>= 0`.
+    ///
+    /// Default 0: the maximum-likelihood model of Eqs. (5)-(8), with a
+    /// pseudo-inverse for singular covariances (zero-variance features and
+    /// directions get weight 0; see the `gaussian` module). A positive ridge is
+    /// deliberate shrinkage: it damps every direction whose standardized
+    /// variance is not large against it, also those that separate the classes
+    /// (1e-6 changed posteriors by up to 0.39 on paper features), and gives a
+    /// boundary even when the classes have no within-class spread.
     pub ridge: f64,
     /// Quadratic discriminant only: weight `alpha` in `[0, 1]` of the shared
     /// covariance in each class covariance, `(1 - alpha) Sigma_c + alpha Sigma`
@@ -41,7 +48,7 @@ impl Default for ZoneConfig {
         ZoneConfig {
             feature_set: FeatureSet::Paper,
             discriminant: Discriminant::Linear,
-            ridge: 1e-6,
+            ridge: 0.0,
             quadratic_pooling: 0.0,
         }
     }

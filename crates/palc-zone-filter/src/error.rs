@@ -49,9 +49,10 @@ pub enum ZoneError {
         /// Samples labelled y = 0.
         unsafe_count: u64,
     },
-    /// The regularized covariance could not be factorized (only possible with `ridge = 0`).
+    /// The eigendecomposition of a covariance did not converge or gave
+    /// non-finite values (a singular covariance is not an error).
     #[error(
-        "the {which} covariance is not positive definite with ridge = {ridge}; use a positive `ridge`"
+        "the eigendecomposition of the {which} covariance failed with ridge = {ridge:e}; its entries are too large or too small"
     )]
     SingularCovariance {
         /// Which covariance (`shared`, `safe class`, `unsafe class`).

@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 use crate::{
     config::{Discriminant, ZoneConfig},
     error::ZoneError,
-    gaussian::{Fitted, logistic, regularized_precision},
+    gaussian::{Fitted, linear_weights, logistic, regularized_precision},
     sample::{Label, Sample, check_point},
     statistics::ClassStatistics,
 };
@@ -72,8 +72,9 @@ impl ZoneModel {
     ///
     /// # Errors
     /// [`ZoneError::DimensionMismatch`] or [`ZoneError::NonFinite`] for a bad
-    /// sample, [`ZoneError::SingularCovariance`] if `ridge = 0` and the
-    /// covariance is singular.
+    /// sample, [`ZoneError::SingularCovariance`] if the eigendecomposition of
+    /// a covariance fails (a singular covariance is not an error: its null
+    /// directions get weight 0).
     pub fn update(&mut self, samples: &[Sample]) -> Result<(), ZoneError> {
         let d = self.dimension();
         for (i, sample) in samples.iter().enumerate() {
@@ -241,15 +242,7 @@ fn fit_parameters(
     let log_prior_ratio = (n1 / n0).ln();
     let fitted = match config.discriminant {
         Discriminant::Linear => {
-            let precision =
-                regularized_precision(&shared, &total_variance, config.ridge, "shared")?;
-            let weights = (0..d)
-                .map(|r| {
-                    (0..d)
-                        .map(|c| precision.matrix[r * d + c] * mean_gap[c])
-                        .sum()
-                })
-                .collect();
+            let weights = linear_weights(&shared, &total_variance, &mean_gap, config.ridge)?;
             let midpoint = safe
                 .mean
                 .iter()

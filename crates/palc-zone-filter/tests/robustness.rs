@@ -53,12 +53,18 @@ fn before_the_first_takeover_only_safe_samples_give_no_bound() {
 }
 
 #[test]
-fn fewer_samples_than_features_still_separate_the_two_points() {
+fn fewer_samples_than_features_separate_the_two_points_with_a_ridge() {
+    // One sample per class has no within-class spread: the ML model has no
+    // boundary (every feature is constant within the classes, weight 0), and
+    // a positive ridge gives the bisector in standardized units.
+    let safe = Sample::new(features_at(FeatureSet::Paper, 0.0, 0.0), Label::Safe);
+    let unsafe_ = Sample::new(features_at(FeatureSet::Paper, 0.0, 1.5), Label::Unsafe);
+    let ml = fit(ZoneConfig::default(), &[safe.clone(), unsafe_.clone()]);
+    assert_eq!(ml.log_odds_safe(&safe.x).unwrap(), 0.0);
     for discriminant in [Discriminant::Linear, Discriminant::Quadratic] {
-        let safe = Sample::new(features_at(FeatureSet::Paper, 0.0, 0.0), Label::Safe);
-        let unsafe_ = Sample::new(features_at(FeatureSet::Paper, 0.0, 1.5), Label::Unsafe);
         let config = ZoneConfig {
             discriminant,
+            ridge: 1e-6,
             ..ZoneConfig::default()
         };
         let model = fit(config, &[safe.clone(), unsafe_.clone()]);
@@ -149,33 +155,35 @@ fn collinear_and_ill_conditioned_paper_features_are_handled() {
 }
 
 #[test]
-fn an_exactly_singular_covariance_without_ridge_is_a_typed_error() {
-    // Two identical columns: the standardized covariance is [[1, 1], [1, 1]].
+fn an_exactly_singular_covariance_fits_with_weight_zero_on_its_null_directions() {
+    // Two identical columns and a constant one: the standardized covariance
+    // of the kept features is [[1, 1, 1], [1, 1, 1], [1, 1, 1]].
     let mut samples = Vec::new();
     for k in 0..10 {
         let v = k as f64;
         samples.push(Sample::new(vec![v, v, 1.0, v], Label::Safe));
         samples.push(Sample::new(vec![v + 3.0, v + 3.0, 1.0, v], Label::Unsafe));
     }
-    let config = ZoneConfig {
-        feature_set: FeatureSet::NoDistance,
-        ridge: 0.0,
-        ..ZoneConfig::default()
-    };
-    let err = ZoneModel::fit(config, &samples).unwrap_err();
-    assert!(
-        matches!(err, ZoneError::SingularCovariance { which: "shared", ridge } if ridge == 0.0),
-        "{err}"
-    );
-    // The default ridge makes the same data usable.
-    let model = fit(
-        ZoneConfig {
-            ridge: 1e-6,
-            ..config
-        },
-        &samples,
-    );
-    assert_eq!(model.classify(&[2.0, 2.0, 1.0, 2.0]).unwrap(), Label::Safe);
+    for ridge in [0.0, 1e-6] {
+        let model = fit(
+            ZoneConfig {
+                feature_set: FeatureSet::NoDistance,
+                ridge,
+                ..ZoneConfig::default()
+            },
+            &samples,
+        );
+        assert_eq!(model.classify(&[2.0, 2.0, 1.0, 2.0]).unwrap(), Label::Safe);
+        assert_eq!(
+            model.classify(&[9.0, 9.0, 1.0, 6.0]).unwrap(),
+            Label::Unsafe
+        );
+        // The constant feature has weight 0.
+        assert_eq!(
+            model.log_odds_safe(&[2.0, 2.0, 1.0, 2.0]).unwrap(),
+            model.log_odds_safe(&[2.0, 2.0, -40.0, 2.0]).unwrap()
+        );
+    }
 }
 
 #[test]

@@ -1,11 +1,14 @@
 //! `palc traffic ...`: background traffic on its own.
 //!
 //! `palc traffic simulate` builds a scene from a scenario config and writes one CSV row per
-//! vehicle per step: `time,id,lane,s,l,v,a` (SI units). In a test-bed scene the ego has no
-//! planner here: it keeps its lane and follows its stand-in IDM (`Scene::step_autonomous`).
+//! vehicle per step: `time,id,lane,s,l,v,a` (SI units), or with `--format json` an array
+//! of objects with the same keys. Numbers are written in full precision (Rust's shortest
+//! representation that reads back to the same `f64`), so that the output can be compared
+//! with a reference at any tolerance. In a test-bed scene the ego has no planner here: it
+//! keeps its lane and follows its stand-in IDM (`Scene::step_autonomous`).
 
 use anyhow::{Context, bail};
-use clap::{Args, Subcommand};
+use clap::{Args, Subcommand, ValueEnum};
 use palc_traffic::{ScenarioConfig, Scene};
 use std::path::PathBuf;
 
@@ -36,9 +39,20 @@ struct SimulateArgs {
     /// Index of the test-bed cell to run (speed case, then headway, then seed); 0 for a platoon.
     #[arg(long, default_value_t = 0)]
     cell: usize,
-    /// Output CSV file.
+    /// Output file.
     #[arg(long)]
     out: PathBuf,
+    /// Output format.
+    #[arg(long, value_enum, default_value_t = Format::Csv)]
+    format: Format,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Format {
+    /// One row per vehicle per step: `time,id,lane,s,l,v,a`.
+    Csv,
+    /// An array of `{time, id, lane, s, l, v, a}` objects.
+    Json,
 }
 
 /// Largest number of steps one run may write, so that a typo cannot fill the disk.
@@ -70,9 +84,7 @@ fn simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             "--duration / --dt = {steps} steps is out of range: at most {MAX_STEPS} steps with dt above 0 s"
         );
     }
-    let mut writer = csv::Writer::from_path(&args.out)
-        .with_context(|| format!("cannot write {}", args.out.display()))?;
-    writer.write_record(["time", "id", "lane", "s", "l", "v", "a"])?;
+    let mut rows = Vec::new();
     // `steps` is a whole number in [0, MAX_STEPS] here, so the cast is exact.
     for step in 0..=(steps as u64) {
         if step > 0 {
@@ -80,19 +92,54 @@ fn simulate(args: &SimulateArgs) -> anyhow::Result<()> {
         }
         for vehicle in scene.vehicles() {
             let state = &vehicle.state;
-            writer.write_record([
-                format!("{:.4}", scene.time()),
-                vehicle.id.0.to_string(),
-                vehicle.lane.0.to_string(),
-                format!("{:.4}", state.s),
-                format!("{:.4}", state.l),
-                format!("{:.4}", state.v),
-                format!("{:.4}", state.a),
-            ])?;
+            rows.push(Row {
+                time: scene.time(),
+                id: vehicle.id.0,
+                lane: vehicle.lane.0,
+                s: state.s,
+                l: state.l,
+                v: state.v,
+                a: state.a,
+            });
         }
     }
-    writer
-        .flush()
-        .with_context(|| format!("cannot write {}", args.out.display()))?;
+    let cannot_write = || format!("cannot write {}", args.out.display());
+    match args.format {
+        Format::Csv => {
+            let mut writer = csv::Writer::from_path(&args.out).with_context(cannot_write)?;
+            writer.write_record(["time", "id", "lane", "s", "l", "v", "a"])?;
+            for r in &rows {
+                // `{}` of an f64 is the shortest string that reads back to the same number.
+                writer.write_record([
+                    r.time.to_string(),
+                    r.id.to_string(),
+                    r.lane.to_string(),
+                    r.s.to_string(),
+                    r.l.to_string(),
+                    r.v.to_string(),
+                    r.a.to_string(),
+                ])?;
+            }
+            writer.flush().with_context(cannot_write)?;
+        }
+        Format::Json => {
+            let file = std::fs::File::create(&args.out).with_context(cannot_write)?;
+            let mut writer = std::io::BufWriter::new(file);
+            serde_json::to_writer(&mut writer, &rows).with_context(cannot_write)?;
+            std::io::Write::flush(&mut writer).with_context(cannot_write)?;
+        }
+    }
     Ok(())
+}
+
+/// One vehicle at one step, as written.
+#[derive(Debug, serde::Serialize)]
+struct Row {
+    time: f64,
+    id: u32,
+    lane: u32,
+    s: f64,
+    l: f64,
+    v: f64,
+    a: f64,
 }
