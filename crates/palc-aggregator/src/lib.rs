@@ -70,6 +70,7 @@ mod experience;
 mod expert;
 mod lesson;
 mod options;
+pub mod output;
 mod resample;
 mod rows;
 mod scale;

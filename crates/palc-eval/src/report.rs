@@ -563,7 +563,9 @@ mod tests {
         assert!(report.contains("## Lessons that could not be learned"));
         assert!(report.contains("## How each claim is measured"));
         // One paragraph after the run count, no stray line break or leading space.
-        assert!(report.contains("grid runs per method. Deterministic users are the paper's set-up.\n"));
+        assert!(
+            report.contains("grid runs per method. Deterministic users are the paper's set-up.\n")
+        );
         assert!(!report.contains("\n "), "a line starts with a space");
     }
 }

@@ -6,7 +6,8 @@
 
 use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
-use palc_traffic::{ScenarioConfig, Scene};
+use palc_aggregator::output;
+use palc_traffic::{MAX_DT, ScenarioConfig, Scene};
 use std::path::PathBuf;
 
 /// Background traffic on its own.
@@ -63,6 +64,12 @@ fn simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             args.duration
         );
     }
+    if !(args.dt > 0.0 && args.dt <= MAX_DT) {
+        bail!(
+            "--dt {:e} s is out of range: it must be in (0, {MAX_DT}] s",
+            args.dt
+        );
+    }
     let steps = (args.duration / args.dt).round();
     let valid = args.dt > 0.0 && steps <= MAX_STEPS;
     if !valid {
@@ -70,29 +77,36 @@ fn simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             "--duration / --dt = {steps} steps is out of range: at most {MAX_STEPS} steps with dt above 0 s"
         );
     }
-    let mut writer = csv::Writer::from_path(&args.out)
-        .with_context(|| format!("cannot write {}", args.out.display()))?;
-    writer.write_record(["time", "id", "lane", "s", "l", "v", "a"])?;
-    // `steps` is a whole number in [0, MAX_STEPS] here, so the cast is exact.
-    for step in 0..=(steps as u64) {
-        if step > 0 {
-            scene.step_autonomous(args.dt)?;
+    // Written through a temporary file: a failure leaves an existing `--out` as it was.
+    let mut failure = None;
+    let written = output::write_with(&args.out, |out| {
+        let mut writer = csv::Writer::from_writer(out);
+        writer.write_record(["time", "id", "lane", "s", "l", "v", "a"])?;
+        // `steps` is a whole number in [0, MAX_STEPS] here, so the cast is exact.
+        for step in 0..=(steps as u64) {
+            if step > 0 {
+                if let Err(error) = scene.step_autonomous(args.dt) {
+                    failure = Some(error);
+                    return Err(std::io::Error::other("the simulation failed"));
+                }
+            }
+            for vehicle in scene.vehicles() {
+                let state = &vehicle.state;
+                writer.write_record([
+                    format!("{:.4}", scene.time()),
+                    vehicle.id.0.to_string(),
+                    vehicle.lane.0.to_string(),
+                    format!("{:.4}", state.s),
+                    format!("{:.4}", state.l),
+                    format!("{:.4}", state.v),
+                    format!("{:.4}", state.a),
+                ])?;
+            }
         }
-        for vehicle in scene.vehicles() {
-            let state = &vehicle.state;
-            writer.write_record([
-                format!("{:.4}", scene.time()),
-                vehicle.id.0.to_string(),
-                vehicle.lane.0.to_string(),
-                format!("{:.4}", state.s),
-                format!("{:.4}", state.l),
-                format!("{:.4}", state.v),
-                format!("{:.4}", state.a),
-            ])?;
-        }
+        writer.flush()
+    });
+    match failure {
+        Some(error) => Err(error).with_context(|| format!("in {}", args.config.display())),
+        None => Ok(written?),
     }
-    writer
-        .flush()
-        .with_context(|| format!("cannot write {}", args.out.display()))?;
-    Ok(())
 }
