@@ -62,6 +62,7 @@
 //! # Ok::<(), palc_aggregator::AggregatorError>(())
 //! ```
 #![warn(missing_docs)]
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 mod convex;
 mod correction;

@@ -12,6 +12,8 @@ use clap::{Parser, Subcommand};
 
 mod commands;
 mod console;
+#[cfg(test)]
+mod fuzz;
 
 /// Personalized automated lane change that learns from the driver's takeovers.
 #[derive(Debug, Parser)]

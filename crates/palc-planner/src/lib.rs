@@ -53,6 +53,7 @@
 //! # Ok::<(), palc_planner::PlanError>(())
 //! ```
 #![warn(missing_docs)]
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 mod backend;
 mod clarabel_backend;
@@ -67,7 +68,7 @@ mod riccati;
 mod validate;
 mod weights;
 
-pub use config::{Backend, LateralBoundsMode, PlannerConfig, SolverSettings};
+pub use config::{Backend, LateralBoundsMode, MAX_HORIZON, PlannerConfig, SolverSettings};
 pub use convexity::check_convexity;
 pub use error::{ConfigError, PlanError, StepRanges};
 pub use features::{features, stage_features};

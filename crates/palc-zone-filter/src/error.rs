@@ -16,7 +16,7 @@ pub enum ZoneError {
         found: usize,
     },
     /// An input number is NaN or infinite.
-    #[error("{field} = {value} is not finite")]
+    #[error("{field} = {value:?} is not finite")]
     NonFinite {
         /// Which input was wrong (e.g. `sample 3 feature dl_p`).
         field: String,
@@ -24,7 +24,7 @@ pub enum ZoneError {
         value: f64,
     },
     /// Time-based features divide by the ego speed, which must be positive.
-    #[error("{field} = {value} m/s must be positive for the time-gap feature set")]
+    #[error("{field} = {value:?} m/s must be positive for the time-gap feature set")]
     NonPositiveSpeed {
         /// Which input was wrong.
         field: String,
@@ -32,7 +32,7 @@ pub enum ZoneError {
         value: f64,
     },
     /// A configuration value is outside its allowed range.
-    #[error("config field `{field}` = {value} is out of range: must be {bound}")]
+    #[error("config field `{field}` = {value:?} is out of range: must be {bound}")]
     InvalidConfig {
         /// The configuration field.
         field: &'static str,
@@ -49,9 +49,11 @@ pub enum ZoneError {
         /// Samples labelled y = 0.
         unsafe_count: u64,
     },
-    /// The regularized covariance could not be factorized (only possible with `ridge = 0`).
+    /// The regularized covariance could not be factorized (with `ridge = 0`, or with
+    /// features so far apart in scale that the ridge is lost in rounding).
     #[error(
-        "the {which} covariance is not positive definite with ridge = {ridge}; use a positive `ridge`"
+        "the {which} covariance is not positive definite with ridge = {ridge:?}; {}",
+        if *ridge > 0.0 { "use a larger `ridge` or features of similar scale" } else { "use a positive `ridge`" }
     )]
     SingularCovariance {
         /// Which covariance (`shared`, `safe class`, `unsafe class`).
