@@ -158,7 +158,7 @@ impl Experience {
         bytes.push(b'\n');
         crate::output::write(path, &bytes).map_err(|e| AggregatorError::Io {
             path: e.path,
-            source: e.source,
+            source: e.error,
         })
     }
 

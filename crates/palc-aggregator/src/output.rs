@@ -31,13 +31,12 @@ const MAX_SYMLINK_HOPS: usize = 40;
 
 /// An output file could not be written; the previous file, if any, is unchanged.
 #[derive(Debug, thiserror::Error)]
-#[error("cannot write {}: {source}", path.display())]
+#[error("cannot write {}: {error}", path.display())]
 pub struct OutputError {
     /// The file that was to be written (as given, before following links).
     pub path: PathBuf,
-    /// The cause.
-    #[source]
-    pub source: io::Error,
+    /// The cause; in the message, so not repeated as a `source`.
+    pub error: io::Error,
 }
 
 /// Writes `bytes` to `path` as [`write_with`] does.
@@ -58,9 +57,9 @@ pub fn write_with(
     path: &Path,
     fill: impl FnOnce(&mut dyn Write) -> io::Result<()>,
 ) -> Result<(), OutputError> {
-    write_inner(path, fill).map_err(|source| OutputError {
+    write_inner(path, fill).map_err(|error| OutputError {
         path: path.to_owned(),
-        source,
+        error,
     })
 }
 
@@ -231,9 +230,9 @@ impl Staging {
     /// # Errors
     /// [`OutputError`] naming `destination`.
     pub fn new(destination: &Path) -> Result<Staging, OutputError> {
-        let error = |source| OutputError {
+        let error = |error| OutputError {
             path: destination.to_owned(),
-            source,
+            error,
         };
         let name = destination
             .file_name()
@@ -286,7 +285,7 @@ impl Staging {
         let destination = self.destination.clone();
         let error = |path: &Path| {
             let path = path.to_owned();
-            move |source| OutputError { path, source }
+            move |error| OutputError { path, error }
         };
         fs::create_dir_all(&destination).map_err(error(&destination))?;
         let mut entries: Vec<fs::DirEntry> = fs::read_dir(self.path())
