@@ -185,3 +185,43 @@ fn the_zone_filter_and_the_planner_depend_on_no_other_palc_crate() {
         assert!(palc.is_empty(), "{name} depends on {palc:?}");
     }
 }
+
+/// Library crates never panic on input: clippy refuses `unwrap`/`expect` outside tests.
+#[test]
+fn library_crates_lint_unwrap_and_expect() {
+    let lint = "#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]";
+    let missing: Vec<String> = crate_dirs()
+        .iter()
+        .map(|dir| dir.join("src/lib.rs"))
+        .filter(|lib| lib.is_file() && !read(lib).contains(lint))
+        .map(|lib| lib.display().to_string())
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "library crates without `{lint}`: {missing:?}"
+    );
+}
+
+/// Every output file goes through `palc_aggregator::output` (atomic, checked).
+#[test]
+fn outputs_are_written_only_through_the_output_module() {
+    let mut files = Vec::new();
+    rust_files(&project_root().join("crates"), &mut files);
+    let writers = [
+        "File::create(",
+        "fs::write(",
+        "Writer::from_path(",
+        "OpenOptions::new(",
+    ];
+    let offenders: Vec<String> = files
+        .iter()
+        .filter(|path| path.components().any(|c| c.as_os_str() == "src"))
+        .filter(|path| !path.ends_with("palc-aggregator/src/output.rs"))
+        .filter(|path| writers.iter().any(|w| read(path).contains(w)))
+        .map(|path| path.display().to_string())
+        .collect();
+    assert!(
+        offenders.is_empty(),
+        "files that write outputs by hand (use palc_aggregator::output): {offenders:?}"
+    );
+}

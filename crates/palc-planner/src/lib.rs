@@ -53,6 +53,7 @@
 //! # Ok::<(), palc_planner::PlanError>(())
 //! ```
 #![warn(missing_docs)]
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 mod backend;
 mod clarabel_backend;
@@ -68,7 +69,8 @@ mod validate;
 mod weights;
 
 pub use config::{
-    Backend, LateralBoundsMode, MAX_ITER_RANGE, PlannerConfig, SolverSettings, TOLERANCE_RANGE,
+    Backend, LateralBoundsMode, MAX_HORIZON, MAX_ITER_RANGE, PlannerConfig, SolverSettings,
+    TOLERANCE_RANGE,
 };
 pub use convexity::check_convexity;
 pub use error::{ConfigError, PlanError, StepRanges};

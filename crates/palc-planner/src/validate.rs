@@ -75,6 +75,15 @@ pub(crate) fn validate_problem(config: &PlannerConfig, problem: &Problem) -> Res
     }
     finite(|| "terminal.v".into(), t.v)?;
     finite(|| "terminal.l".into(), t.l)?;
+    for (field, v) in [("initial.v", problem.initial.v), ("terminal.v", t.v)] {
+        if v < 0.0 {
+            return Err(PlanError::OutOfRange {
+                field: field.into(),
+                value: v,
+                bound: ">= 0 (the model drives forwards only)",
+            });
+        }
+    }
     for (i, b) in problem.lateral_bounds.iter().enumerate() {
         let Some(b) = b else { continue };
         if let Some(min) = b.min {

@@ -29,7 +29,7 @@
 //! assert!(prediction.adjacent[0][1] > 3.0); // the adjacent vehicle is on the target lane
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
-
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 #![warn(missing_docs)]
 
 mod config;
@@ -50,7 +50,7 @@ pub use config::{
 pub use error::{ConfigError, SceneError};
 pub use idm::{BallisticStep, DesiredGap, IdmParams, MIN_INTERACTION_GAP, ballistic_step};
 pub use prediction::{MAX_HORIZON_STEPS, Prediction, PredictionModel};
-pub use road::{Lane, Road};
+pub use road::{Lane, MAX_LANES, Road};
 pub use scene::{MAX_DT, MAX_VEHICLES, Scene};
-pub use testbed::{PAPER_ADJACENT_HEADWAYS, SpeedCase, TestbedCell};
+pub use testbed::{MAX_POSITION_JITTER_M, PAPER_ADJACENT_HEADWAYS, SpeedCase, TestbedCell};
 pub use vehicle::{Driver, EgoState, SpeedProfile, Vehicle, VehicleId, VehicleState};

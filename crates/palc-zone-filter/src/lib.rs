@@ -67,6 +67,7 @@
 //! # Ok::<(), palc_zone_filter::ZoneError>(())
 //! ```
 #![warn(missing_docs)]
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 mod bounds;
 mod config;
