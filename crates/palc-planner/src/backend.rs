@@ -9,7 +9,9 @@ pub(crate) enum RawStatus {
     AlmostSolved,
     /// A certificate of primal infeasibility was found (in `RawSolution::z`).
     PrimalInfeasible,
-    /// A certificate of dual infeasibility (an unbounded direction) was found.
+    /// A certificate of dual infeasibility (an unbounded direction) was found; only
+    /// clarabel looks for one.
+    #[cfg_attr(not(feature = "clarabel"), allow(dead_code))]
     DualInfeasible,
     /// Stopped without a solution; the string names the reason.
     Failed(String),

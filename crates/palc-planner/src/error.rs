@@ -19,6 +19,16 @@ pub enum ConfigError {
         /// The allowed range, in words.
         bound: &'static str,
     },
+    /// The chosen backend was not compiled in: its cargo feature is off.
+    #[error(
+        "config field `backend` = {backend} needs the `{feature}` feature of palc-planner, which is off; enable it or use `riccati`"
+    )]
+    BackendUnavailable {
+        /// The backend, as spelled in a configuration file, e.g. `clarabel`.
+        backend: &'static str,
+        /// The cargo feature that provides it.
+        feature: &'static str,
+    },
 }
 
 /// Sets of steps, printed as `3..=7, 10`.

@@ -55,6 +55,7 @@
 #![warn(missing_docs)]
 
 mod backend;
+#[cfg(feature = "clarabel")]
 mod clarabel_backend;
 mod config;
 mod convexity;

@@ -1,5 +1,6 @@
 //! The 10 x K weight matrix of Eq. (15) and the feature matrix of Eq. (34).
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 /// Number of features per stage (rows of `w` and `Φ`, Eq. 34).
@@ -46,8 +47,9 @@ pub mod feature {
 macro_rules! stage_matrix {
     ($(#[$doc:meta])* $name:ident) => {
         $(#[$doc])*
-        #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-        #[serde(transparent)]
+        #[derive(Debug, Clone, PartialEq)]
+        #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+        #[cfg_attr(feature = "serde", serde(transparent))]
         pub struct $name(Vec<[f64; FEATURE_COUNT]>);
 
         impl $name {

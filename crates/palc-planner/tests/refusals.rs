@@ -54,6 +54,29 @@ fn invalid_config_names_the_field() {
     assert!(Planner::new(bad).is_err());
 }
 
+/// Without the `clarabel` feature the reference backend is a configuration error, not
+/// a compile error or a panic; with it, the same configuration builds a planner.
+#[test]
+fn clarabel_backend_needs_its_feature() {
+    let config = PlannerConfig {
+        backend: palc_planner::Backend::Clarabel,
+        ..PlannerConfig::default()
+    };
+    if cfg!(feature = "clarabel") {
+        assert!(Planner::new(config).is_ok());
+    } else {
+        let err = Planner::new(config).unwrap_err();
+        assert!(matches!(
+            err,
+            PlanError::Config(ConfigError::BackendUnavailable {
+                backend: "clarabel",
+                feature: "clarabel",
+            })
+        ));
+        assert!(err.to_string().contains("`clarabel` feature"));
+    }
+}
+
 #[test]
 fn mismatched_dimensions_are_refused() {
     let c = config(30, LateralBoundsMode::Hard);
