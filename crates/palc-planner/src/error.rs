@@ -95,6 +95,12 @@ pub enum PlanError {
         /// Given length.
         found: usize,
     },
+    /// A [`ProblemBuilder`](crate::ProblemBuilder) was built without a required input.
+    #[error("`{field}` was not given; set it on the problem builder")]
+    MissingField {
+        /// The input, e.g. `initial`.
+        field: &'static str,
+    },
     /// An input number is NaN or infinite.
     #[error("`{field}` is {value}, expected a finite number")]
     NonFinite {

@@ -55,6 +55,7 @@
 #![warn(missing_docs)]
 
 mod backend;
+mod builder;
 #[cfg(feature = "clarabel")]
 mod clarabel_backend;
 mod config;
@@ -68,6 +69,7 @@ mod riccati;
 mod validate;
 mod weights;
 
+pub use builder::ProblemBuilder;
 pub use config::{
     Backend, LateralBoundsMode, MAX_ITER_RANGE, PlannerConfig, SolverSettings, TOLERANCE_RANGE,
 };
@@ -78,4 +80,4 @@ pub use planner::{Extras, Plan, Planner, SolveStats, SolveStatus};
 pub use problem::{
     Control, LateralBound, MAX_POSITION, Position, Problem, State, Terminal, Tracking,
 };
-pub use weights::{FEATURE_COUNT, Features, Weights, feature};
+pub use weights::{FEATURE_COUNT, Features, StageWeights, Weights, feature};
