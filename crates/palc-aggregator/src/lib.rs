@@ -61,7 +61,7 @@
 //! assert!(after <= before);
 //! # Ok::<(), palc_aggregator::AggregatorError>(())
 //! ```
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 mod convex;
 mod correction;

@@ -45,7 +45,7 @@
 //! ```
 #![doc = include_str!("../examples/plan_lane_change.rs")]
 //! ```
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 mod backend;
 mod builder;

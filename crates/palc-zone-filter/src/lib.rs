@@ -32,7 +32,7 @@
 //! ```
 #![doc = include_str!("../examples/fit_zone.rs")]
 //! ```
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 
 mod bounds;
 mod config;
