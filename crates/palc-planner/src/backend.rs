@@ -1,5 +1,7 @@
 //! What every QP backend returns to the planner.
 
+use crate::SolverFailure;
+
 /// How a backend finished, in backend-neutral terms.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum RawStatus {
@@ -13,8 +15,8 @@ pub(crate) enum RawStatus {
     /// clarabel looks for one.
     #[cfg_attr(not(feature = "clarabel"), allow(dead_code))]
     DualInfeasible,
-    /// Stopped without a solution; the string names the reason.
-    Failed(String),
+    /// Stopped without a solution.
+    Failed(SolverFailure),
 }
 
 /// Raw result of one solve, in the variable and row order of [`QpData`](crate::qp::QpData).

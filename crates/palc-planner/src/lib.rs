@@ -67,7 +67,7 @@ pub use config::{
     Backend, LateralBoundsMode, MAX_ITER_RANGE, PlannerConfig, SolverSettings, TOLERANCE_RANGE,
 };
 pub use convexity::check_convexity;
-pub use error::{ConfigError, PlanError, StepRanges};
+pub use error::{ConfigError, LayoutError, NumericalCause, PlanError, SolverFailure, StepRanges};
 pub use features::{features, stage_features};
 pub use planner::{Extras, Plan, Planner, SolveStats, SolveStatus};
 pub use problem::{

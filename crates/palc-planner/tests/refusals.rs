@@ -77,6 +77,32 @@ fn clarabel_backend_needs_its_feature() {
     }
 }
 
+/// The default backend's failures are typed, with a readable message.
+#[test]
+fn an_iteration_limit_is_a_typed_failure() {
+    let config = PlannerConfig {
+        horizon: 30,
+        solver: SolverSettings {
+            max_iter: 2,
+            ..SolverSettings::default()
+        },
+        ..PlannerConfig::default()
+    };
+    let problem = lane_change(&config, 20.0);
+    let err = Planner::new(config).unwrap().plan(&problem).unwrap_err();
+    assert_eq!(
+        err,
+        PlanError::SolverFailed {
+            status: palc_planner::SolverFailure::MaxIterations,
+            iterations: 2,
+        }
+    );
+    assert_eq!(
+        err.to_string(),
+        "qp solver failed with status max iterations after 2 iterations"
+    );
+}
+
 #[test]
 fn mismatched_dimensions_are_refused() {
     let c = config(30, LateralBoundsMode::Hard);
