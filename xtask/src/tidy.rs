@@ -36,27 +36,34 @@ fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
     }
 }
 
-/// The external crates of `[workspace.dependencies]` (those without a `path`).
-fn external_workspace_dependencies() -> Vec<String> {
-    let manifest = read(&project_root().join("Cargo.toml"));
+/// The `name = spec` lines of one `[section]` of a TOML manifest, as (name, spec).
+fn section_entries(manifest: &str, section: &str) -> Vec<(String, String)> {
     let mut in_section = false;
-    let mut names = Vec::new();
+    let mut entries = Vec::new();
     for line in manifest.lines() {
         let line = line.trim();
         if line.starts_with('[') {
-            in_section = line == "[workspace.dependencies]";
+            in_section = line == section;
             continue;
         }
         if !in_section || line.is_empty() || line.starts_with('#') {
             continue;
         }
-        if let Some((name, spec)) = line.split_once('=') {
-            if !spec.contains("path =") {
-                names.push(name.trim().to_owned());
-            }
+        if let Some((name, spec)) = line.split_once(['=', '.']) {
+            entries.push((name.trim().to_owned(), spec.to_owned()));
         }
     }
-    names
+    entries
+}
+
+/// The external crates of `[workspace.dependencies]` (those without a `path`).
+fn external_workspace_dependencies() -> Vec<String> {
+    let manifest = read(&project_root().join("Cargo.toml"));
+    section_entries(&manifest, "[workspace.dependencies]")
+        .into_iter()
+        .filter(|(_, spec)| !spec.contains("path ="))
+        .map(|(name, _)| name)
+        .collect()
 }
 
 #[test]
@@ -143,22 +150,10 @@ fn xtask_stays_within_its_line_budget() {
 
 /// The `[dependencies]` (not dev-dependencies) of a crate's manifest, by name.
 fn dependencies(manifest: &Path) -> Vec<String> {
-    let text = read(manifest);
-    let mut in_section = false;
-    let mut names = Vec::new();
-    for line in text.lines() {
-        let line = line.trim();
-        if line.starts_with('[') {
-            in_section = line == "[dependencies]";
-            continue;
-        }
-        if in_section && !line.is_empty() && !line.starts_with('#') {
-            if let Some((name, _)) = line.split_once(['=', '.']) {
-                names.push(name.trim().to_owned());
-            }
-        }
-    }
-    names
+    section_entries(&read(manifest), "[dependencies]")
+        .into_iter()
+        .map(|(name, _)| name)
+        .collect()
 }
 
 #[test]
@@ -189,4 +184,44 @@ fn the_zone_filter_and_the_planner_depend_on_no_other_palc_crate() {
             .collect();
         assert!(palc.is_empty(), "{name} depends on {palc:?}");
     }
+}
+
+/// Library crates never panic on input: clippy refuses `unwrap`/`expect` outside tests.
+#[test]
+fn library_crates_lint_unwrap_and_expect() {
+    let lint = "#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]";
+    let missing: Vec<String> = crate_dirs()
+        .iter()
+        .map(|dir| dir.join("src/lib.rs"))
+        .filter(|lib| lib.is_file() && !read(lib).contains(lint))
+        .map(|lib| lib.display().to_string())
+        .collect();
+    assert!(
+        missing.is_empty(),
+        "library crates without `{lint}`: {missing:?}"
+    );
+}
+
+/// Every output file goes through `palc_aggregator::output` (atomic, checked).
+#[test]
+fn outputs_are_written_only_through_the_output_module() {
+    let mut files = Vec::new();
+    rust_files(&project_root().join("crates"), &mut files);
+    let writers = [
+        "File::create(",
+        "fs::write(",
+        "Writer::from_path(",
+        "OpenOptions::new(",
+    ];
+    let offenders: Vec<String> = files
+        .iter()
+        .filter(|path| path.components().any(|c| c.as_os_str() == "src"))
+        .filter(|path| !path.ends_with("palc-aggregator/src/output.rs"))
+        .filter(|path| writers.iter().any(|w| read(path).contains(w)))
+        .map(|path| path.display().to_string())
+        .collect();
+    assert!(
+        offenders.is_empty(),
+        "files that write outputs by hand (use palc_aggregator::output): {offenders:?}"
+    );
 }

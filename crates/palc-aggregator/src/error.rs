@@ -25,7 +25,7 @@ pub enum AggregatorError {
         source: PlanError,
     },
     /// An option lies outside its allowed range.
-    #[error("option `{field}` = {value} is out of range: must be {bound}")]
+    #[error("option `{field}` = {value:?} is out of range: must be {bound}")]
     InvalidOption {
         /// The option, e.g. `incremental.step_size`.
         field: &'static str,
@@ -51,7 +51,7 @@ pub enum AggregatorError {
         found: usize,
     },
     /// A number (weight, feature, state) is NaN or infinite.
-    #[error("`{field}` is {value}, expected a finite number")]
+    #[error("`{field}` is {value:?}, expected a finite number")]
     NonFinite {
         /// The input with its index, e.g. `weights[3][8]`.
         field: String,

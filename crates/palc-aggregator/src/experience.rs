@@ -1,8 +1,7 @@
 //! The experience store: what was learned, versioned, saved without ever losing data.
 
 use std::fs;
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use palc_planner::Weights;
 use palc_zone_filter::ZoneModel;
@@ -134,9 +133,10 @@ impl Experience {
         Ok(())
     }
 
-    /// Writes the experience to `path` without ever losing data: to a temporary file
-    /// in the same directory first, flushed to disk (`fsync`), then renamed over
-    /// `path` (atomic on POSIX file systems), then the directory is synced. On any
+    /// Writes the experience to `path` without ever losing data, through
+    /// [`crate::output::write`]: a temporary file in the same directory, flushed and
+    /// synced, renamed over `path`, the directory synced; an existing file keeps its
+    /// permissions and a symbolic link keeps pointing to the file it names. On any
     /// error the previous file at `path` is left as it was.
     ///
     /// # Errors
@@ -156,35 +156,9 @@ impl Experience {
                 reason: e.to_string(),
             })?;
         bytes.push(b'\n');
-        let io = |source| AggregatorError::Io {
-            path: path.to_path_buf(),
-            source,
-        };
-        let file_name = path.file_name().ok_or_else(|| {
-            io(std::io::Error::new(
-                std::io::ErrorKind::InvalidInput,
-                "the path names no file",
-            ))
-        })?;
-        let directory = match path.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
-            _ => PathBuf::from("."),
-        };
-        let mut temporary_name = std::ffi::OsString::from(".");
-        temporary_name.push(file_name);
-        temporary_name.push(format!(".tmp-{}", std::process::id()));
-        let temporary = directory.join(temporary_name);
-        let write = || -> std::io::Result<()> {
-            let mut file = fs::File::create(&temporary)?;
-            file.write_all(&bytes)?;
-            file.sync_all()?;
-            drop(file);
-            fs::rename(&temporary, path)?;
-            sync_directory(&directory)
-        };
-        write().map_err(|e| {
-            let _ = fs::remove_file(&temporary);
-            io(e)
+        crate::output::write(path, &bytes).map_err(|e| AggregatorError::Io {
+            path: e.path,
+            source: e.error,
         })
     }
 
@@ -232,14 +206,4 @@ impl Experience {
         experience.validate().map_err(|e| corrupt(e.to_string()))?;
         Ok(experience)
     }
-}
-
-#[cfg(unix)]
-fn sync_directory(directory: &Path) -> std::io::Result<()> {
-    fs::File::open(directory)?.sync_all()
-}
-
-#[cfg(not(unix))]
-fn sync_directory(_directory: &Path) -> std::io::Result<()> {
-    Ok(())
 }

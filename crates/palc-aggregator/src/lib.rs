@@ -62,6 +62,7 @@
 //! # Ok::<(), palc_aggregator::AggregatorError>(())
 //! ```
 #![deny(missing_docs)]
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 mod convex;
 mod correction;
@@ -70,6 +71,7 @@ mod experience;
 mod expert;
 mod lesson;
 mod options;
+pub mod output;
 mod resample;
 mod rows;
 mod scale;

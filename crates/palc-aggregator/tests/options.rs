@@ -82,7 +82,7 @@ fn unknown_fields_and_bad_values_are_refused() {
     let err = bad.validate().unwrap_err();
     assert_eq!(
         err.to_string(),
-        "option `correction.step_size` = -1 is out of range: must be finite and > 0"
+        "option `correction.step_size` = -1.0 is out of range: must be finite and > 0"
     );
     let bad: AggregatorOptions =
         toml::from_str("feature_scale = [1, 1, 1, 1, 0, 1, 1, 1, 1, 1]").unwrap();

@@ -1,11 +1,19 @@
 //! `palc`: the command line of palc, a thin layer over the library crates.
 //!
 //! Each subcommand lives in its own module under `commands/`; this file only
-//! parses arguments and dispatches.
+//! parses arguments and dispatches. Every output file is written through
+//! `palc_aggregator::output` (nothing is truncated in place), and every line for the
+//! user goes through `console` (a closed stdout ends the command quietly, with its
+//! files saved).
+
+use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 
 mod commands;
+mod console;
+#[cfg(test)]
+mod fuzz;
 
 /// Personalized automated lane change that learns from the driver's takeovers.
 #[derive(Debug, Parser)]
@@ -30,13 +38,26 @@ enum Command {
     Zone(commands::zone::ZoneArgs),
 }
 
-fn main() -> anyhow::Result<()> {
+fn main() -> ExitCode {
     let cli = Cli::parse();
-    match cli.command {
+    let result = match cli.command {
         Command::Eval(args) => commands::eval::run(args),
         Command::Learn(args) => commands::learn::run_learn(args),
         Command::Traffic(args) => commands::traffic::run(args),
         Command::Plan(args) => commands::plan::run(args),
         Command::Zone(args) => commands::zone::run(args),
+    };
+    let result = result.and_then(|()| match console::failure() {
+        Some(error) => Err(anyhow::Error::new(error).context("cannot write to the terminal")),
+        None => Ok(()),
+    });
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        // The reader of our output has gone away (`palc ... | head`): not a failure.
+        Err(error) if console::is_broken_pipe(&error) => ExitCode::SUCCESS,
+        Err(error) => {
+            console::report(&error);
+            ExitCode::FAILURE
+        }
     }
 }

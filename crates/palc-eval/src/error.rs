@@ -19,6 +19,9 @@ pub enum EvalError {
         /// The cause.
         source: std::io::Error,
     },
+    /// An output file could not be written; the previous one is unchanged.
+    #[error(transparent)]
+    Output(#[from] palc_aggregator::output::OutputError),
     /// An error inside a config file, with the file's path.
     #[error("in {}: {source}", path.display())]
     InFile {

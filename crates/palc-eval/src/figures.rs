@@ -247,8 +247,20 @@ impl Figure for Lines {
                 .draw_series(shown().map(|p| Circle::new(p, 3, colour.filled())))
                 .map_err(plot_error)?;
         }
-        let entries: Vec<(&str, RGBColor)> = (self.series.iter().enumerate())
-            .map(|(s, (name, _))| (name.as_str(), COLOURS[s % COLOURS.len()]))
+        // A log axis cannot show 0: say so in the legend instead of dropping it silently.
+        let names: Vec<String> = (self.series.iter())
+            .map(|(name, points)| {
+                let zeros = points.iter().filter(|p| p.1 <= 0.0).count();
+                match zeros {
+                    0 => name.clone(),
+                    _ if !self.log_y => name.clone(),
+                    z if z == points.len() => format!("{name} (0, not drawn)"),
+                    z => format!("{name} ({z} at 0, not drawn)"),
+                }
+            })
+            .collect();
+        let entries: Vec<(&str, RGBColor)> = (names.iter().enumerate())
+            .map(|(s, name)| (name.as_str(), COLOURS[s % COLOURS.len()]))
             .collect();
         legend(&legend_area, &entries, Swatch::Line)
     }
@@ -517,15 +529,19 @@ mod tests {
             title: "compute".into(),
             x_desc: "K".into(),
             y_desc: "ms (log scale)".into(),
-            series: vec![(
-                "palc".into(),
-                vec![(40.0, 0.01), (80.0, 0.4), (120.0, 25.0)],
-            )],
+            series: vec![
+                (
+                    "palc".into(),
+                    vec![(40.0, 0.01), (80.0, 0.4), (120.0, 25.0)],
+                ),
+                ("paper".into(), vec![(40.0, 0.0), (80.0, 0.0)]),
+            ],
             y_range: None,
             log_y: true,
         };
         let [log_svg, _] = save(&dir, "log", (640, 400), &log).unwrap();
         let log_text = std::fs::read_to_string(&log_svg).unwrap();
+        assert!(log_text.contains("paper (0, not drawn)"), "{log_text}");
         // Whole decades from 0.01 to 100 ms, each a tick label of its own.
         for decade in ["0.01", "0.1", "1", "10", "100"] {
             assert!(

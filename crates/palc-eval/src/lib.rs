@@ -28,6 +28,7 @@
 //! nothing; progress goes to a [`Progress`] that the caller supplies.
 #![deny(missing_docs)]
 #![warn(clippy::print_stdout, clippy::print_stderr)]
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod claims;
 pub mod config;
@@ -56,6 +57,7 @@ pub use results::{Iteration, RunRow, Status};
 pub use runner::{NoProgress, Progress};
 
 use manifest::Manifest;
+use palc_aggregator::output::{self, Staging};
 
 /// What to evaluate and where to write it; the defaults are the paper's
 /// reproduction, run from the workspace root.
@@ -180,18 +182,18 @@ impl Evaluation {
 /// Runs the whole evaluation described by `options` and writes its outputs:
 /// `runs.json`, `runs.csv`, `example.json`, `manifest.json`, the figures (with
 /// the `plot` feature) and `REPORT.md`. Nothing is written before both configs
-/// are read and checked and the runs are planned.
+/// are read and checked and the runs are planned; the outputs are written into a
+/// staging directory next to `options.out` and moved into it only when all are
+/// written, so an error leaves the previous results intact.
 pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcome, EvalError> {
     let evaluation = Evaluation::load(&options.config, options.quick)?;
     let plan = evaluation.plan()?;
     let example_spec = evaluation.example_spec()?;
     let jobs = options.jobs.unwrap_or_else(manifest::cores).max(1);
-    let out = &options.out;
-    std::fs::create_dir_all(out).map_err(|source| EvalError::Io {
-        action: "create",
-        path: out.clone(),
-        source,
-    })?;
+    // Everything is written into a staging directory next to `--out` and moved into
+    // place at the end: a run that fails leaves the previous results as they were.
+    let staging = Staging::new(&options.out)?;
+    let out = staging.path();
 
     let start = Instant::now();
     let rows = runner::execute(&plan, &evaluation.harness, jobs, progress)?;
@@ -249,8 +251,13 @@ pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcom
         figures: &figures,
         manifest: &manifest,
     });
-    let report = out.join("REPORT.md");
-    write(&report, &report_text)?;
+    write(&out.join("REPORT.md"), &report_text)?;
+    // The example's files of an earlier run are removed when this one has none.
+    staging.commit(
+        &["manifest.json", "REPORT.md"],
+        &["example.json", "fig06-example.svg", "fig06-example.png"],
+    )?;
+    let report = options.out.join("REPORT.md");
     Ok(Outcome {
         report,
         runs: rows.len(),
@@ -259,9 +266,5 @@ pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcom
 }
 
 fn write(path: &Path, text: &str) -> Result<(), EvalError> {
-    std::fs::write(path, text).map_err(|source| EvalError::Io {
-        action: "write",
-        path: path.to_owned(),
-        source,
-    })
+    Ok(output::write(path, text.as_bytes())?)
 }

@@ -185,12 +185,9 @@ struct CsvRow<'a> {
 /// Writes `runs.json` (every field) and `runs.csv` (one line per run).
 pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> Result<(), EvalError> {
     let text = serde_json::to_string_pretty(rows)?;
-    std::fs::write(json, text).map_err(|source| EvalError::Io {
-        action: "write",
-        path: json.to_owned(),
-        source,
-    })?;
-    let mut writer = csv::Writer::from_path(csv_path)?;
+    palc_aggregator::output::write(json, text.as_bytes())?;
+    let mut bytes = Vec::new();
+    let mut writer = csv::Writer::from_writer(&mut bytes);
     for row in rows {
         let note = match &row.status {
             Status::Refused { reason } => reason.clone(),
@@ -221,11 +218,9 @@ pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> Result<(), EvalEr
             note,
         })?;
     }
-    writer.flush().map_err(|source| EvalError::Io {
-        action: "write",
-        path: csv_path.to_owned(),
-        source,
-    })?;
+    writer.flush().map_err(csv::Error::from)?;
+    drop(writer);
+    palc_aggregator::output::write(csv_path, &bytes)?;
     Ok(())
 }
 

@@ -88,10 +88,9 @@ impl UserConfig {
                 style.validate("user.custom")?;
                 Ok(style)
             }
-            (UserStyle::Custom, None) => Err(HarnessError::InvalidConfig {
-                field: "user.custom".to_owned(),
-                value: f64::NAN,
-                bound: "a [user.custom] table when style = \"custom\"".to_owned(),
+            (UserStyle::Custom, None) => Err(HarnessError::MissingTable {
+                table: "user.custom",
+                reason: "`user.style` is \"custom\"",
             }),
         }
     }
@@ -165,6 +164,14 @@ impl std::fmt::Display for UserStyle {
     }
 }
 
+/// Largest `loop.max_takeovers`: a run keeps a record of every lane change, so the
+/// caps on a run's length bound its memory.
+pub const MAX_TAKEOVERS: usize = 1_000;
+/// Largest `loop.success_streak` (the paper's is 3).
+pub const MAX_SUCCESS_STREAK: usize = 100;
+/// Largest `loop.max_lane_changes` and `loop.spread_window`.
+pub const MAX_LANE_CHANGES: usize = 1_000;
+
 /// When a run stops.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -227,17 +234,21 @@ impl LearnConfig {
         self.user.style()?;
         self.planning.validate()?;
         let s = &self.stopping;
-        for (field, value) in [
-            ("loop.max_takeovers", s.max_takeovers),
-            ("loop.success_streak", s.success_streak),
-            ("loop.spread_window", s.spread_window),
-            ("loop.max_lane_changes", s.max_lane_changes),
+        for (field, value, max) in [
+            ("loop.max_takeovers", s.max_takeovers, MAX_TAKEOVERS),
+            ("loop.success_streak", s.success_streak, MAX_SUCCESS_STREAK),
+            ("loop.spread_window", s.spread_window, MAX_LANE_CHANGES),
+            (
+                "loop.max_lane_changes",
+                s.max_lane_changes,
+                MAX_LANE_CHANGES,
+            ),
         ] {
-            if value == 0 {
+            if !(1..=max).contains(&value) {
                 return Err(HarnessError::InvalidConfig {
                     field: field.to_owned(),
-                    value: 0.0,
-                    bound: "at least 1".to_owned(),
+                    value: value as f64,
+                    bound: format!("a whole number in [1, {max}]"),
                 });
             }
         }

@@ -7,7 +7,7 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum HarnessError {
     /// A config value is out of its bound.
-    #[error("invalid config: `{field}` is {value}, expected {bound}")]
+    #[error("invalid config: `{field}` is {value:?}, expected {bound}")]
     InvalidConfig {
         /// Dotted path of the field.
         field: String,
@@ -15,6 +15,14 @@ pub enum HarnessError {
         value: f64,
         /// The bound it violates.
         bound: String,
+    },
+    /// A table that the config needs is missing.
+    #[error("invalid config: the table [{table}] is missing; it is needed because {reason}")]
+    MissingTable {
+        /// Dotted path of the table.
+        table: &'static str,
+        /// Why the table is needed.
+        reason: &'static str,
     },
     /// A style name that is none of the valid ones.
     #[error("unknown driving style `{name}`: expected one of {expected}")]

@@ -28,6 +28,7 @@
 //! ```
 #![deny(missing_docs)]
 #![warn(clippy::print_stdout, clippy::print_stderr)]
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 mod config;
 mod drive;
@@ -42,7 +43,10 @@ mod setup;
 mod standard_alc;
 pub mod user;
 
-pub use config::{CellChoice, LearnConfig, StoppingConfig, UserConfig, UserStyle};
+pub use config::{
+    CellChoice, LearnConfig, MAX_LANE_CHANGES, MAX_SUCCESS_STREAK, MAX_TAKEOVERS, StoppingConfig,
+    UserConfig, UserStyle,
+};
 pub use drive::{Drive, execute, problem};
 pub use error::HarnessError;
 pub use learn::{RunResult, aggregator_options, prepare, run};

@@ -2,7 +2,7 @@
 
 use crate::validate::{
     check_reference_speed, check_tracking, finite, finite_lateral_bounds, finite_positions,
-    finite_state, finite_terminal, finite_weights, length, within_max_position,
+    finite_state, finite_terminal, finite_weights, forward_speed, length, within_max_position,
 };
 use crate::{
     LateralBound, PlanError, Position, Problem, StageWeights, State, Terminal, Tracking, Weights,
@@ -88,9 +88,10 @@ impl ProblemBuilder {
         self.horizon
     }
 
-    /// `X_0` of Eq. (20): finite, `|s| <=` [`MAX_POSITION`](crate::MAX_POSITION).
+    /// `X_0` of Eq. (20): finite, `v >= 0`, `|s| <=` [`MAX_POSITION`](crate::MAX_POSITION).
     pub fn initial(mut self, initial: State) -> Result<Self, PlanError> {
         finite_state("initial", &initial)?;
+        forward_speed("initial.v", initial.v)?;
         within_max_position(|| "initial.s".into(), initial.s)?;
         self.initial = Some(initial);
         Ok(self)
@@ -141,9 +142,10 @@ impl ProblemBuilder {
         Ok(self)
     }
 
-    /// The terminal condition of Eq. (21): finite.
+    /// The terminal condition of Eq. (21): finite, `v >= 0`.
     pub fn terminal(mut self, terminal: Terminal) -> Result<Self, PlanError> {
         finite_terminal(&terminal)?;
+        forward_speed("terminal.v", terminal.v)?;
         if let Some(s) = terminal.s {
             within_max_position(|| "terminal.s".into(), s)?;
         }

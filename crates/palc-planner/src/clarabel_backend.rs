@@ -65,6 +65,10 @@ impl ClarabelBackend {
                 .is_some_and(|c| c.pattern == pattern && c.solver.is_data_update_allowed());
         let mut reused = false;
         if reusable {
+            #[allow(
+                clippy::expect_used,
+                reason = "`reusable` holds only with a cached solver"
+            )]
             let cached = self.cached.as_mut().expect("checked above");
             cached.p.scatter(&data.p_vals, &mut self.p_nz);
             cached.a.scatter(&data.a_vals, &mut self.a_nz);
@@ -116,6 +120,7 @@ impl ClarabelBackend {
             });
         }
         let setup_seconds = start.elapsed().as_secs_f64();
+        #[allow(clippy::expect_used, reason = "the cache is filled just above")]
         let cached = self.cached.as_mut().expect("set above");
         let start = std::time::Instant::now();
         cached.solver.solve();

@@ -5,6 +5,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::ConfigError;
 
+/// Largest horizon K: the QP's memory grows linearly with K (a few kB a step).
+pub const MAX_HORIZON: usize = 10_000;
+
 /// How the lateral bounds of Eq. (22) enter the QP.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
@@ -165,11 +168,11 @@ impl PlannerConfig {
                 })
             }
         };
-        if self.horizon == 0 {
+        if self.horizon == 0 || self.horizon > MAX_HORIZON {
             return Err(ConfigError::OutOfRange {
                 field: "horizon",
-                value: 0.0,
-                bound: "at least 1",
+                value: self.horizon as f64,
+                bound: "in [1, 10000] (MAX_HORIZON)",
             });
         }
         let positive = "finite and > 0";

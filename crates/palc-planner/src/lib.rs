@@ -46,6 +46,7 @@
 #![doc = include_str!("../examples/plan_lane_change.rs")]
 //! ```
 #![deny(missing_docs)]
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 mod backend;
 mod builder;
@@ -64,7 +65,8 @@ mod weights;
 
 pub use builder::ProblemBuilder;
 pub use config::{
-    Backend, LateralBoundsMode, MAX_ITER_RANGE, PlannerConfig, SolverSettings, TOLERANCE_RANGE,
+    Backend, LateralBoundsMode, MAX_HORIZON, MAX_ITER_RANGE, PlannerConfig, SolverSettings,
+    TOLERANCE_RANGE,
 };
 pub use convexity::check_convexity;
 pub use error::{ConfigError, LayoutError, NumericalCause, PlanError, SolverFailure, StepRanges};

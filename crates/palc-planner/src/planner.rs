@@ -180,6 +180,10 @@ impl Planner {
             .map(|s| s.map_or(0.0, |j| x[j]))
             .collect();
         let features = features(&states, &controls, &problem.preceding, &problem.adjacent)?;
+        #[allow(
+            clippy::expect_used,
+            reason = "the problem was validated against the horizon"
+        )]
         let learned_cost = problem
             .weights
             .dot(&features)

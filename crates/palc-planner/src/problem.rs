@@ -9,6 +9,7 @@ use crate::Weights;
 /// The state `X_i = [s, v, l, φ]` of Eq. (9), in the order of NOTES item 3.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct State {
     /// Longitudinal (Frenet) position (m).
     pub s: f64,
@@ -40,6 +41,7 @@ impl State {
 /// The control `U_i = [a, δ]` of Eq. (10).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Control {
     /// Longitudinal acceleration (m/s²).
     pub a: f64,
@@ -50,6 +52,7 @@ pub struct Control {
 /// A predicted position of another vehicle in the Frenet frame.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Position {
     /// Longitudinal position (m), in the same origin as the ego's `s`.
     pub s: f64,

@@ -72,6 +72,18 @@ pub(crate) fn finite_positions(name: &str, positions: &[Position]) -> Result<(),
     Ok(())
 }
 
+/// A speed of the ego `>= 0`: the model drives forwards only.
+pub(crate) fn forward_speed(field: &'static str, v: f64) -> Result<(), PlanError> {
+    if v < 0.0 {
+        return Err(PlanError::OutOfRange {
+            field: field.into(),
+            value: v,
+            bound: ">= 0 (the model drives forwards only)",
+        });
+    }
+    Ok(())
+}
+
 /// Every given terminal component finite.
 pub(crate) fn finite_terminal(t: &Terminal) -> Result<(), PlanError> {
     if let Some(s) = t.s {
@@ -134,6 +146,8 @@ pub(crate) fn validate_problem(config: &PlannerConfig, problem: &Problem) -> Res
     finite_positions("preceding", &problem.preceding)?;
     finite_positions("adjacent", &problem.adjacent)?;
     finite_terminal(&problem.terminal)?;
+    forward_speed("initial.v", problem.initial.v)?;
+    forward_speed("terminal.v", problem.terminal.v)?;
     finite_lateral_bounds(&problem.lateral_bounds)?;
     if let Some(tracking) = &problem.tracking {
         check_tracking(tracking)?;

@@ -120,6 +120,13 @@ fn each_input_is_checked_when_it_is_given() {
                 ..State::default()
             }),
         ),
+        (
+            "initial.v",
+            b().initial(State {
+                v: -1.0,
+                ..State::default()
+            }),
+        ),
         ("reference_speed", b().reference_speed(vec![20.0; 29])),
         ("reference_speed[3]", {
             let mut v = vec![20.0; 30];

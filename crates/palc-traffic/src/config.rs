@@ -272,8 +272,9 @@ impl ScenarioConfig {
         let r = &self.road;
         positive("road.length_m", r.length_m)?;
         positive("road.lane_width_m", r.lane_width_m)?;
-        if r.lanes == 0 {
-            return Err(out_of_range("road.lanes", 0.0, "at least 1"));
+        if r.lanes == 0 || r.lanes > crate::road::MAX_LANES {
+            let bound = format!("in [1, {}]", crate::road::MAX_LANES);
+            return Err(out_of_range("road.lanes", f64::from(r.lanes), &bound));
         }
         Ok(Road {
             length: r.length_m,

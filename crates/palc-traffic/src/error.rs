@@ -13,7 +13,7 @@ pub enum ConfigError {
     #[error("invalid scenario config: {0}")]
     Toml(#[from] toml::de::Error),
     /// A number lies outside the range it must lie in (negative length, speed in wrong units).
-    #[error("`{field}` = {value} is out of range: it must be {bound}")]
+    #[error("`{field}` = {value:?} is out of range: it must be {bound}")]
     OutOfRange {
         /// Dotted path of the field, as in the config.
         field: String,
@@ -135,7 +135,7 @@ pub enum SceneError {
         max: f64,
     },
     /// A field of the supplied ego state is out of range.
-    #[error("ego state `{field}` = {value} is out of range: it must be {bound}")]
+    #[error("ego state `{field}` = {value:?} is out of range: it must be {bound}")]
     InvalidEgoState {
         /// The field.
         field: &'static str,

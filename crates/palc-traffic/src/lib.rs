@@ -31,6 +31,7 @@
 //! ```
 
 #![deny(missing_docs)]
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 mod config;
 mod error;
@@ -50,7 +51,7 @@ pub use config::{
 pub use error::{ConfigError, SceneError};
 pub use idm::{BallisticStep, DesiredGap, IdmParams, MIN_INTERACTION_GAP, ballistic_step};
 pub use prediction::{MAX_HORIZON_STEPS, Prediction, PredictionModel};
-pub use road::{Lane, Road};
+pub use road::{Lane, MAX_LANES, Road};
 pub use scene::{MAX_DT, MAX_VEHICLES, Scene};
-pub use testbed::{PAPER_ADJACENT_HEADWAYS, SpeedCase, TestbedCell};
+pub use testbed::{MAX_POSITION_JITTER_M, PAPER_ADJACENT_HEADWAYS, SpeedCase, TestbedCell};
 pub use vehicle::{Driver, EgoState, SpeedProfile, Vehicle, VehicleId, VehicleState};

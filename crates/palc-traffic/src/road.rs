@@ -7,6 +7,10 @@
 
 use serde::{Deserialize, Serialize};
 
+/// Most lanes a road may have (`road.lanes`): far more than any road, and few enough
+/// that the per-lane work of a scene stays small.
+pub const MAX_LANES: u32 = 64;
+
 /// Index of a lane, counted from the ego's initial lane (0) to the left.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 pub struct Lane(pub u32);

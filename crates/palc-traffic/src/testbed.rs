@@ -13,7 +13,7 @@
 //! - every background vehicle but the preceding one gets a uniform position jitter.
 
 use crate::config::{
-    MAX_SPEED_MPH, ScenarioConfig, TestbedConfig, in_range, non_negative, out_of_range, positive,
+    MAX_SPEED_MPH, ScenarioConfig, TestbedConfig, in_range, out_of_range, positive,
 };
 use crate::error::ConfigError;
 use crate::road::Lane;
@@ -23,6 +23,10 @@ use crate::vehicle::{Driver, Vehicle, VehicleId, VehicleState};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
+
+/// Largest `testbed.position_jitter_m` (m): half the test bed's road length, far
+/// beyond any sensible jitter, and a bound that keeps every draw finite.
+pub const MAX_POSITION_JITTER_M: f64 = 100.0;
 
 /// One of the paper's speed cases, in SI units.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -198,7 +202,13 @@ pub(crate) fn build(config: &ScenarioConfig, cell: &TestbedCell) -> Result<Scene
         1.0,
         "in [adjacent_phase[0], 1]",
     )?;
-    let jitter = non_negative("testbed.position_jitter_m", testbed.position_jitter_m)?;
+    let jitter = in_range(
+        "testbed.position_jitter_m",
+        testbed.position_jitter_m,
+        0.0,
+        MAX_POSITION_JITTER_M,
+        &format!("in [0, {MAX_POSITION_JITTER_M}] m"),
+    )?;
     if let Some(follower) = testbed.follower_headway_m {
         positive("testbed.follower_headway_m", follower)?;
     }

@@ -207,7 +207,7 @@ fn invalid_steps_and_predictions_are_refused() {
     let bad = scene.step(0.1, EgoState { v: -1.0, ..ego }).unwrap_err();
     assert_eq!(
         bad.to_string(),
-        "ego state `v` = -1 is out of range: it must be finite and at least 0"
+        "ego state `v` = -1.0 is out of range: it must be finite and at least 0"
     );
     assert!(matches!(
         scene.step(

@@ -33,6 +33,7 @@
 #![doc = include_str!("../examples/fit_zone.rs")]
 //! ```
 #![deny(missing_docs)]
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 mod bounds;
 mod config;

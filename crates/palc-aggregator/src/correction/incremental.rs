@@ -92,6 +92,10 @@ impl RewardCorrection for IncrementalRule {
     ) -> Result<CorrectionOutcome, AggregatorError> {
         self.validate()?;
         check_horizons(input)?;
+        #[allow(
+            clippy::expect_used,
+            reason = "`check_horizons` just checked the horizons"
+        )]
         let error = |f: &Features| {
             feature_error(f, input.expert, input.scale, input.learnable)
                 .expect("horizons were checked")

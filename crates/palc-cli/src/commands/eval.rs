@@ -10,6 +10,8 @@ use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use palc_eval::{EvalOptions, Progress, RunRow, evaluate};
 
+use crate::console::say;
+
 /// Arguments of `palc eval` (and of `cargo xtask reproduce-paper`).
 #[derive(Debug, Args)]
 pub struct EvalArgs {
@@ -62,7 +64,7 @@ impl Progress for Shown {
         self.total.store(total, Ordering::Relaxed);
         match &self.bar {
             Some(bar) => bar.set_length(total as u64),
-            None => println!("{total} runs"),
+            None => say!("{total} runs"),
         }
     }
 
@@ -78,7 +80,7 @@ impl Progress for Shown {
         if done % step == 0 || done == total {
             let elapsed = self.start.elapsed().as_secs_f64();
             let eta = elapsed / done as f64 * total.saturating_sub(done) as f64;
-            println!("[{done}/{total}] {elapsed:.0} s elapsed, about {eta:.0} s left");
+            say!("[{done}/{total}] {elapsed:.0} s elapsed, about {eta:.0} s left");
         }
     }
 
@@ -97,7 +99,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         quick: args.quick,
         jobs: args.jobs,
     };
-    println!(
+    say!(
         "evaluating {}{} on {} threads",
         options.config.display(),
         if options.quick { " (quick subset)" } else { "" },
@@ -106,7 +108,7 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
             .map_or_else(|| "all".to_owned(), |j| j.to_string())
     );
     let outcome = evaluate(&options, &Shown::new())?;
-    println!(
+    say!(
         "{} runs in {:.1} s; report: {}",
         outcome.runs,
         outcome.wall_s,

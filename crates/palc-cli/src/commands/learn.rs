@@ -4,11 +4,13 @@ use std::path::PathBuf;
 
 use anyhow::Context;
 use clap::Args;
-use palc_aggregator::Experience;
+use palc_aggregator::{Experience, output};
 use palc_harness::{
     CellChoice, LaneChangeRecord, LearnConfig, LessonEvent, Method, Observer, RunSummary,
     UserConfig, UserStyle, run,
 };
+
+use crate::console::say;
 
 /// The default config, compiled in so that `palc learn` alone works anywhere.
 const DEFAULT_CONFIG: &str = include_str!("../../../../configs/learn.toml");
@@ -52,7 +54,7 @@ struct Printer;
 impl Observer for Printer {
     fn lane_change(&mut self, record: &LaneChangeRecord) {
         match record.takeover {
-            Some(t) => println!(
+            Some(t) => say!(
                 "lane change {:>2}: takeover at {:5.1} s ({:6.1} m), deviation {:.2} m, perceived safety {:.2}",
                 record.index + 1,
                 t.time_s,
@@ -60,7 +62,7 @@ impl Observer for Printer {
                 t.deviation_m,
                 record.perceived_safety_ratio
             ),
-            None => println!(
+            None => say!(
                 "lane change {:>2}: no takeover, max deviation {:.2} m",
                 record.index + 1,
                 record.max_deviation_m
@@ -70,12 +72,12 @@ impl Observer for Printer {
 
     fn lesson(&mut self, event: &LessonEvent<'_>) {
         if let LessonEvent::Failed { error, .. } = event {
-            println!("               learning step failed, experience unchanged: {error}");
+            say!("               learning step failed, experience unchanged: {error}");
         }
     }
 
     fn finished(&mut self, summary: &RunSummary) {
-        println!(
+        say!(
             "{:?} after {} takeovers in {} lane changes (final max deviation {:.2} m)",
             summary.outcome,
             summary.counted_takeovers(),
@@ -83,7 +85,7 @@ impl Observer for Printer {
             summary.final_max_deviation_m
         );
         if summary.learning_failures > 0 {
-            println!(
+            say!(
                 "{} of the lessons could not be learned from",
                 summary.learning_failures
             );
@@ -129,7 +131,7 @@ pub fn run_learn(args: LearnArgs) -> anyhow::Result<()> {
         ),
         None => None,
     };
-    println!("{} ({} method)", config.label(), config.method.name());
+    say!("{} ({} method)", config.label(), config.method.name());
     let result = run(&config, experience.as_ref(), &mut Printer)?;
     if let Some(path) = &args.save_experience {
         result
@@ -138,8 +140,9 @@ pub fn run_learn(args: LearnArgs) -> anyhow::Result<()> {
             .with_context(|| format!("cannot save {}", path.display()))?;
     }
     if let Some(path) = &args.record {
-        let json = serde_json::to_string_pretty(&result)?;
-        std::fs::write(path, json).with_context(|| format!("cannot write {}", path.display()))?;
+        let mut json = serde_json::to_vec_pretty(&result)?;
+        json.push(b'\n');
+        output::write(path, &json)?;
     }
     Ok(())
 }

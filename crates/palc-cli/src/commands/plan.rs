@@ -24,16 +24,15 @@
 //! `{status, iterations, build_seconds, solve_seconds, structure_reused}`; on refusal
 //! `message`. A refusal also exits with an error after writing the output.
 
-use std::{
-    fs::File,
-    io::{BufReader, BufWriter, Write},
-    path::PathBuf,
-};
+use std::{fs::File, io::BufReader, path::PathBuf};
 
 use anyhow::{Context, bail};
 use clap::Args;
+use palc_aggregator::output;
 use palc_planner::{Plan, PlanError, Planner, PlannerConfig, Problem, SolveStatus};
 use serde::{Deserialize, Serialize};
+
+use crate::console;
 
 /// Plan one lane change from a JSON problem.
 #[derive(Debug, Args)]
@@ -50,10 +49,10 @@ pub struct PlanArgs {
 /// The input file.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct PlanInput {
+pub(crate) struct PlanInput {
     #[serde(default)]
-    config: PlannerConfig,
-    problem: Problem,
+    pub(crate) config: PlannerConfig,
+    pub(crate) problem: Problem,
 }
 
 /// The output file.
@@ -100,22 +99,11 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
             plan: None,
         },
     };
+    let mut bytes = serde_json::to_vec_pretty(&output)?;
+    bytes.push(b'\n');
     match &args.out {
-        Some(out) => {
-            let file =
-                File::create(out).with_context(|| format!("cannot create {}", out.display()))?;
-            let mut writer = BufWriter::new(file);
-            serde_json::to_writer_pretty(&mut writer, &output)
-                .map_err(std::io::Error::from)
-                .and_then(|()| writer.write_all(b"\n"))
-                .and_then(|()| writer.flush())
-                .with_context(|| format!("cannot write {}", out.display()))?;
-        }
-        None => {
-            let mut stdout = std::io::stdout().lock();
-            serde_json::to_writer_pretty(&mut stdout, &output)?;
-            writeln!(stdout)?;
-        }
+        Some(out) => output::write(out, &bytes)?,
+        None => console::data(&bytes).context("cannot write the plan to stdout")?,
     }
     if let Err(error) = result {
         bail!("{}: {error}", path.display());

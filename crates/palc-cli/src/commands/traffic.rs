@@ -9,7 +9,8 @@
 
 use anyhow::{Context, bail};
 use clap::{Args, Subcommand, ValueEnum};
-use palc_traffic::{ScenarioConfig, Scene};
+use palc_aggregator::output;
+use palc_traffic::{MAX_DT, ScenarioConfig, Scene};
 use std::path::PathBuf;
 
 /// Background traffic on its own.
@@ -77,6 +78,12 @@ fn simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             args.duration
         );
     }
+    if !(args.dt > 0.0 && args.dt <= MAX_DT) {
+        bail!(
+            "--dt {:e} s is out of range: it must be in (0, {MAX_DT}] s",
+            args.dt
+        );
+    }
     let steps = (args.duration / args.dt).round();
     let valid = args.dt > 0.0 && steps <= MAX_STEPS;
     if !valid {
@@ -103,10 +110,11 @@ fn simulate(args: &SimulateArgs) -> anyhow::Result<()> {
             });
         }
     }
-    let cannot_write = || format!("cannot write {}", args.out.display());
-    match args.format {
+    // The whole run is simulated before `--out` is touched, and written through a
+    // temporary file: a failure leaves an existing `--out` as it was.
+    output::write_with(&args.out, |out| match args.format {
         Format::Csv => {
-            let mut writer = csv::Writer::from_path(&args.out).with_context(cannot_write)?;
+            let mut writer = csv::Writer::from_writer(out);
             writer.write_record(["time", "id", "lane", "s", "l", "v", "a"])?;
             for r in &rows {
                 // `{}` of an f64 is the shortest string that reads back to the same number.
@@ -120,15 +128,10 @@ fn simulate(args: &SimulateArgs) -> anyhow::Result<()> {
                     r.a.to_string(),
                 ])?;
             }
-            writer.flush().with_context(cannot_write)?;
+            writer.flush()
         }
-        Format::Json => {
-            let file = std::fs::File::create(&args.out).with_context(cannot_write)?;
-            let mut writer = std::io::BufWriter::new(file);
-            serde_json::to_writer(&mut writer, &rows).with_context(cannot_write)?;
-            std::io::Write::flush(&mut writer).with_context(cannot_write)?;
-        }
-    }
+        Format::Json => serde_json::to_writer(out, &rows).map_err(std::io::Error::other),
+    })?;
     Ok(())
 }
 

@@ -14,14 +14,17 @@
 
 use std::{
     fs::File,
-    io::{BufReader, BufWriter, Read, Write},
+    io::{BufReader, Read, Write},
     path::{Path, PathBuf},
 };
 
 use anyhow::{Context, bail};
 use clap::{Args, Subcommand, ValueEnum};
+use palc_aggregator::output;
 use palc_zone_filter::{Discriminant, FeatureSet, Label, Sample, ZoneConfig, ZoneModel};
 use serde::Serialize;
+
+use crate::console::{self, warning};
 
 /// The perceived safe zone filter (GDA, paper Eqs. 1-8).
 #[derive(Debug, Args)]
@@ -91,7 +94,12 @@ fn fit(args: &FitArgs) -> anyhow::Result<()> {
         Some(path) => {
             let text = std::fs::read_to_string(path)
                 .with_context(|| format!("cannot read config {}", path.display()))?;
-            toml::from_str::<ZoneConfig>(&text).with_context(|| format!("in {}", path.display()))?
+            let config = toml::from_str::<ZoneConfig>(&text)
+                .with_context(|| format!("in {}", path.display()))?;
+            config
+                .validate()
+                .with_context(|| format!("in {}", path.display()))?;
+            config
         }
         None => ZoneConfig::default(),
     };
@@ -101,18 +109,24 @@ fn fit(args: &FitArgs) -> anyhow::Result<()> {
             DiscriminantArg::Quadratic => Discriminant::Quadratic,
         };
     }
+    let config_name = args.config.as_ref().map_or_else(
+        || "the default zone config".to_owned(),
+        |p| p.display().to_string(),
+    );
     let samples = read_samples(&args.samples, config.feature_set)?;
+    // The samples were checked as they were read; what is left for `fit` to refuse
+    // is the pair of config and samples (e.g. a covariance the ridge cannot repair).
     let model = ZoneModel::fit(config, &samples)
-        .with_context(|| format!("in {}", args.samples.display()))?;
-    let file = create(&args.out)?;
-    serde_json::to_writer_pretty(BufWriter::new(file), &model)
-        .with_context(|| format!("cannot write {}", args.out.display()))?;
+        .with_context(|| format!("fitting {} with {config_name}", args.samples.display()))?;
+    let mut bytes = serde_json::to_vec_pretty(&model)?;
+    bytes.push(b'\n');
+    output::write(&args.out, &bytes)?;
     let (safe, unsafe_) = (
         model.safe_statistics().count,
         model.unsafe_statistics().count,
     );
     if !model.is_informative() {
-        eprintln!(
+        warning!(
             "warning: {safe} safe and {unsafe_} unsafe samples; the model has no boundary until both classes have samples"
         );
     }
@@ -141,14 +155,17 @@ fn classify(args: &ClassifyArgs) -> anyhow::Result<()> {
             p_safe: p,
         })
         .collect();
+    let mut bytes = Vec::new();
     match &args.out {
         Some(path) if is_json(path) => {
-            serde_json::to_writer_pretty(BufWriter::new(create(path)?), &results)
-                .with_context(|| format!("cannot write {}", path.display()))
+            serde_json::to_writer_pretty(&mut bytes, &results)?;
+            bytes.push(b'\n');
         }
-        Some(path) => write_csv(create(path)?, &results)
-            .with_context(|| format!("cannot write {}", path.display())),
-        None => write_csv(std::io::stdout().lock(), &results).context("cannot write to stdout"),
+        _ => write_csv(&mut bytes, &results)?,
+    }
+    match &args.out {
+        Some(path) => Ok(output::write(path, &bytes)?),
+        None => console::data(&bytes).context("cannot write the classes to stdout"),
     }
 }
 
@@ -162,10 +179,6 @@ struct Classified {
 fn is_json(path: &Path) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("json"))
-}
-
-fn create(path: &Path) -> anyhow::Result<File> {
-    File::create(path).with_context(|| format!("cannot create {}", path.display()))
 }
 
 fn open(path: &Path) -> anyhow::Result<BufReader<File>> {
@@ -206,7 +219,7 @@ fn read_points(path: &Path, set: FeatureSet) -> anyhow::Result<Vec<f64>> {
     }
 }
 
-fn samples_from_csv(reader: impl Read, set: FeatureSet) -> anyhow::Result<Vec<Sample>> {
+pub(crate) fn samples_from_csv(reader: impl Read, set: FeatureSet) -> anyhow::Result<Vec<Sample>> {
     csv_rows(reader, set, true)?
         .into_iter()
         .map(|(x, y)| Ok(Sample::new(x, y.context("missing label")?)))
@@ -227,12 +240,21 @@ fn csv_rows(
         .context("cannot read the header line")?
         .clone();
     let column = |name: &str| -> anyhow::Result<usize> {
-        headers.iter().position(|h| h == name).with_context(|| {
+        let mut found = headers.iter().enumerate().filter(|(_, h)| *h == name);
+        let (j, _) = found.next().with_context(|| {
             format!(
-                "no column `{name}` in the header; the feature set {set:?} needs {:?}",
+                "line 1: no column `{name}` in the header; the feature set {set:?} needs {:?}",
                 set.names()
             )
-        })
+        })?;
+        if let Some((k, _)) = found.next() {
+            bail!(
+                "line 1: the column `{name}` appears twice in the header (columns {} and {}); keep one",
+                j + 1,
+                k + 1
+            );
+        }
+        Ok(j)
     };
     let feature_columns = set
         .names()
@@ -243,18 +265,18 @@ fn csv_rows(
     let mut rows = Vec::new();
     for record in csv.records() {
         let record = record.context("cannot read a CSV record")?;
+        // csv counts lines from 1, the header being line 1.
         let line = record.position().map_or(0, |p| p.line());
         let field = |j: usize| record.get(j).unwrap_or("");
         let x = feature_columns
             .iter()
             .zip(set.names())
-            .map(|(&j, name)| {
-                field(j).parse::<f64>().with_context(|| {
-                    format!(
-                        "line {line}: column `{name}` value `{}` is not a number",
-                        field(j)
-                    )
-                })
+            .map(|(&j, name)| match field(j).parse::<f64>() {
+                Ok(x) if x.is_finite() => Ok(x),
+                _ => bail!(
+                    "line {line}: column `{name}` value `{}` is not a finite number",
+                    field(j)
+                ),
             })
             .collect::<anyhow::Result<Vec<_>>>()?;
         let y = match label_column {

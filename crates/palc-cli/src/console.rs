@@ -1,0 +1,96 @@
+//! Lines for the user on stdout and stderr that never panic.
+//!
+//! `println!` panics when stdout is closed (`palc learn | head -1`). Here a closed
+//! stream (`EPIPE`) is remembered and later lines to it are dropped, so the command
+//! finishes its work and saves its outputs; it then ends quietly with success, as
+//! `git` and `ripgrep` do. Any other failure to write (a full disk behind a
+//! redirection) is kept and reported when the command ends.
+
+use std::fmt;
+use std::io::{self, Write};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
+
+static STDOUT_CLOSED: AtomicBool = AtomicBool::new(false);
+static STDERR_CLOSED: AtomicBool = AtomicBool::new(false);
+static FAILURE: Mutex<Option<io::Error>> = Mutex::new(None);
+
+/// Prints a line on stdout (a message, not the command's data).
+macro_rules! say {
+    ($($arg:tt)*) => { $crate::console::line(false, format_args!($($arg)*)) };
+}
+
+/// Prints a line on stderr.
+macro_rules! warning {
+    ($($arg:tt)*) => { $crate::console::line(true, format_args!($($arg)*)) };
+}
+
+pub(crate) use {say, warning};
+
+/// Writes one line to stdout (or stderr); see the module's documentation.
+pub fn line(to_stderr: bool, args: fmt::Arguments<'_>) {
+    let closed = if to_stderr {
+        &STDERR_CLOSED
+    } else {
+        &STDOUT_CLOSED
+    };
+    if closed.load(Ordering::Relaxed) {
+        return;
+    }
+    let result = if to_stderr {
+        writeln!(io::stderr().lock(), "{args}")
+    } else {
+        let mut stdout = io::stdout().lock();
+        writeln!(stdout, "{args}").and_then(|()| stdout.flush())
+    };
+    if let Err(error) = result {
+        closed.store(true, Ordering::Relaxed);
+        remember(error);
+    }
+}
+
+/// Writes the command's data (a plan, classified points) to stdout, checked.
+pub fn data(bytes: &[u8]) -> io::Result<()> {
+    if STDOUT_CLOSED.load(Ordering::Relaxed) {
+        return Ok(());
+    }
+    let mut stdout = io::stdout().lock();
+    let result = stdout.write_all(bytes).and_then(|()| stdout.flush());
+    if let Err(error) = &result {
+        if error.kind() == io::ErrorKind::BrokenPipe {
+            STDOUT_CLOSED.store(true, Ordering::Relaxed);
+            return Ok(());
+        }
+    }
+    result
+}
+
+fn remember(error: io::Error) {
+    if error.kind() == io::ErrorKind::BrokenPipe {
+        return;
+    }
+    if let Ok(mut failure) = FAILURE.lock() {
+        failure.get_or_insert(error);
+    }
+}
+
+/// The first failure to write a line that was not a closed pipe, if any.
+pub fn failure() -> Option<io::Error> {
+    FAILURE.lock().ok().and_then(|mut f| f.take())
+}
+
+/// Whether `error` comes from a closed pipe (the reader has gone away).
+pub fn is_broken_pipe(error: &anyhow::Error) -> bool {
+    error.chain().any(|cause| {
+        cause
+            .downcast_ref::<io::Error>()
+            .is_some_and(|e| e.kind() == io::ErrorKind::BrokenPipe)
+    })
+}
+
+/// Reports the error that ends the command on stderr, if stderr is still open.
+pub fn report(error: &anyhow::Error) {
+    if !STDERR_CLOSED.load(Ordering::Relaxed) {
+        let _ = writeln!(io::stderr().lock(), "Error: {error:?}");
+    }
+}

@@ -1,0 +1,244 @@
+//! Fuzz-style property tests of every input format `palc` reads: random bytes,
+//! random truncations and random field mutations of the shipped examples in
+//! `configs/`. Each parser must return a typed error or a value that is valid and
+//! carries no NaN; none may panic.
+//!
+//! The default budget is small (proptest's `PROPTEST_CASES`, 64 cases here); run
+//! `PROPTEST_CASES=100000 cargo test -p palc-cli --release fuzz` for a long run.
+
+use palc_eval::EvalConfig;
+use palc_harness::LearnConfig;
+use palc_planner::Planner;
+use palc_traffic::{ScenarioConfig, Scene};
+use palc_zone_filter::{FeatureSet, ZoneModel};
+use proptest::prelude::*;
+use proptest::test_runner::Config;
+
+use crate::commands::{plan::PlanInput, zone::samples_from_csv};
+
+const LEARN: &str = include_str!("../../../configs/learn.toml");
+const TESTBED: &str = include_str!("../../../configs/testbed.toml");
+const PLATOON: &str = include_str!("../../../configs/platoon.toml");
+const REPRODUCE: &str = include_str!("../../../configs/reproduce.toml");
+const PLAN: &str = include_str!("../../../configs/examples/plan-problem.json");
+const SAMPLES: &str = include_str!("../../../configs/examples/zone-samples.csv");
+
+/// Values that have broken parsers before: extremes, non-numbers, wrong types.
+const NASTY: &[&str] = &[
+    "0",
+    "-0",
+    "-1",
+    "1e308",
+    "-1e308",
+    "1e-308",
+    "4294967295",
+    "18446744073709551615",
+    "1000000",
+    "nan",
+    "inf",
+    "-inf",
+    "NaN",
+    "\"x\"",
+    "[]",
+    "{}",
+    "true",
+    "",
+    "0.5",
+    "3",
+];
+
+/// The budget: `PROPTEST_CASES` if set, else a small one for CI.
+fn config() -> Config {
+    let cases = std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|c| c.parse().ok())
+        .unwrap_or(64);
+    Config {
+        cases,
+        failure_persistence: None,
+        ..Config::default()
+    }
+}
+
+/// The byte ranges of the number-like tokens of `text` (digits, signs, dots, `e`).
+fn number_spans(text: &str) -> Vec<(usize, usize)> {
+    let bytes = text.as_bytes();
+    let mut spans = Vec::new();
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i].is_ascii_digit() {
+            let start = if i > 0 && bytes[i - 1] == b'-' {
+                i - 1
+            } else {
+                i
+            };
+            while i < bytes.len()
+                && (bytes[i].is_ascii_digit() || matches!(bytes[i], b'.' | b'e' | b'E' | b'-'))
+            {
+                i += 1;
+            }
+            spans.push((start, i));
+        } else {
+            i += 1;
+        }
+    }
+    spans
+}
+
+/// One input derived from `example`: a field mutation (most cases), a truncation, or
+/// random bytes.
+fn mutated(example: &'static str) -> impl Strategy<Value = String> {
+    let spans = number_spans(example);
+    let count = spans.len().max(1);
+    let field = (
+        proptest::collection::vec((0..count, 0..NASTY.len()), 1..4),
+        any::<bool>(),
+    )
+        .prop_map(move |(edits, drop_line)| {
+            let mut edits: Vec<(usize, &str)> = edits
+                .into_iter()
+                .filter_map(|(s, v)| spans.get(s).map(|_| (s, NASTY[v])))
+                .collect();
+            edits.sort_by_key(|e| std::cmp::Reverse(e.0));
+            edits.dedup_by_key(|e| e.0);
+            let mut text = example.to_owned();
+            for (s, value) in edits {
+                let (a, b) = spans[s];
+                text.replace_range(a..b, value);
+            }
+            if drop_line {
+                // Also remove one line, which may be a whole table header or a field.
+                let lines: Vec<&str> = text.lines().collect();
+                let k = text.len() % lines.len().max(1);
+                let kept: Vec<&str> = (lines.iter().enumerate())
+                    .filter(|(i, _)| *i != k)
+                    .map(|(_, l)| *l)
+                    .collect();
+                text = kept.join("\n");
+            }
+            text
+        });
+    let truncated = (0..=example.len()).prop_map(move |cut| {
+        let mut cut = cut;
+        while !example.is_char_boundary(cut) {
+            cut -= 1;
+        }
+        example[..cut].to_owned()
+    });
+    let bytes = proptest::collection::vec(any::<u8>(), 0..512)
+        .prop_map(|b| String::from_utf8_lossy(&b).into_owned());
+    prop_oneof![6 => field, 2 => truncated, 1 => bytes]
+}
+
+/// A parsed value must not carry a NaN on: no `NaN` in its `Debug` text outside
+/// its strings (a name may well contain the letters).
+fn no_nan(value: &impl std::fmt::Debug) -> Result<(), TestCaseError> {
+    let text = format!("{value:?}");
+    let (mut numbers, mut in_string, mut escaped) = (String::new(), false, false);
+    for c in text.chars() {
+        match (in_string, escaped, c) {
+            (true, true, _) => escaped = false,
+            (true, false, '\\') => escaped = true,
+            (_, false, '"') => in_string = !in_string,
+            (false, _, c) => numbers.push(c),
+            _ => {}
+        }
+    }
+    prop_assert!(!numbers.contains("NaN"), "a NaN travelled on: {text}");
+    Ok(())
+}
+
+proptest! {
+    #![proptest_config(config())]
+
+    #[test]
+    fn fuzz_learn_config(text in mutated(LEARN)) {
+        // The [traffic] tables are checked when the cell's scene is built, before any
+        // run: what must be NaN-free is what the loop is given.
+        if let Ok(config) = LearnConfig::from_toml_str(&text) {
+            no_nan(&config.stopping)?;
+            no_nan(&config.user)?;
+            if let Ok(cell) = config.cell() {
+                if let Ok(scene) = Scene::for_cell(&config.traffic, &cell) {
+                    no_nan(&(cell, scene))?;
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn fuzz_testbed_config(text in mutated(TESTBED)) {
+        // `from_toml_str` checks the road, vehicle and IDM tables; the scenario's own
+        // table is checked when a scene is built, which is what a simulation gets.
+        if let Ok(config) = ScenarioConfig::from_toml_str(&text) {
+            no_nan(&(&config.road, &config.vehicle, &config.idm))?;
+            if let Ok(scene) = Scene::from_config(&config, 0) {
+                no_nan(&scene)?;
+            }
+        }
+    }
+
+    #[test]
+    fn fuzz_platoon_config(text in mutated(PLATOON)) {
+        // `from_toml_str` checks the road, vehicle and IDM tables; the scenario's own
+        // table is checked when a scene is built, which is what a simulation gets.
+        if let Ok(config) = ScenarioConfig::from_toml_str(&text) {
+            no_nan(&(&config.road, &config.vehicle, &config.idm))?;
+            if let Ok(scene) = Scene::from_config(&config, 0) {
+                no_nan(&scene)?;
+            }
+        }
+    }
+
+    #[test]
+    fn fuzz_eval_config(text in mutated(REPRODUCE)) {
+        if let Ok(config) = EvalConfig::from_toml_str(&text) {
+            no_nan(&config)?;
+            let base = LearnConfig::from_toml_str(LEARN).unwrap();
+            let testbed = base.traffic.testbed.as_ref().unwrap();
+            for quick in [true, false] {
+                if let Ok(selection) = config.select(quick, testbed) {
+                    no_nan(&selection)?;
+                    let _ = palc_eval::plan::expand(&selection, testbed);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn fuzz_plan_problem(text in mutated(PLAN)) {
+        if let Ok(input) = serde_json::from_str::<PlanInput>(&text) {
+            if let Ok(mut planner) = Planner::new(input.config) {
+                if let Ok(plan) = planner.plan(&input.problem) {
+                    no_nan(&plan)?;
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn fuzz_zone_samples(text in mutated(SAMPLES)) {
+        if let Ok(samples) = samples_from_csv(text.as_bytes(), FeatureSet::Paper) {
+            no_nan(&samples)?;
+            if let Ok(model) = ZoneModel::fit(Default::default(), &samples) {
+                no_nan(&model)?;
+            }
+        }
+    }
+}
+
+#[test]
+fn the_shipped_examples_parse() {
+    LearnConfig::from_toml_str(LEARN).unwrap();
+    for text in [TESTBED, PLATOON] {
+        let config = ScenarioConfig::from_toml_str(text).unwrap();
+        Scene::from_config(&config, 0).unwrap();
+    }
+    EvalConfig::from_toml_str(REPRODUCE).unwrap();
+    let input: PlanInput = serde_json::from_str(PLAN).unwrap();
+    Planner::new(input.config)
+        .unwrap()
+        .plan(&input.problem)
+        .unwrap();
+    samples_from_csv(SAMPLES.as_bytes(), FeatureSet::Paper).unwrap();
+}

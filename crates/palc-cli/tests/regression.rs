@@ -1,0 +1,309 @@
+//! One test per fault of issue 13 ("nothing lost, nothing silent"): each ran the
+//! `palc` binary into a panic, a lost or truncated output, a bad input accepted with
+//! exit 0 or an error that did not name the input.
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+fn workspace_file(path: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../..")
+        .join(path)
+}
+
+fn read(path: &str) -> String {
+    std::fs::read_to_string(workspace_file(path)).unwrap()
+}
+
+/// A fresh scratch directory for one test.
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("regression-{name}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn palc(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_palc"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("palc runs")
+}
+
+/// The command failed with a message that contains every one of `needles`, and
+/// did not panic.
+fn fails_with(output: &Output, needles: &[&str]) {
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!output.status.success(), "exit 0; stderr: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    for needle in needles {
+        assert!(stderr.contains(needle), "`{needle}` not in: {stderr}");
+    }
+}
+
+fn succeeds(output: &Output) {
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
+#[cfg(target_os = "linux")]
+#[test]
+fn zone_fit_to_a_full_disk_is_an_error() {
+    let dir = scratch("full-disk");
+    let samples = workspace_file("configs/examples/zone-samples.csv");
+    let output = palc(
+        &[
+            "zone",
+            "fit",
+            "--samples",
+            samples.to_str().unwrap(),
+            "--out",
+            "/dev/full",
+        ],
+        &dir,
+    );
+    fails_with(&output, &["/dev/full"]);
+}
+
+#[test]
+fn a_closed_stdout_ends_learn_quietly_with_the_experience_saved() {
+    let dir = scratch("closed-stdout");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_palc"))
+        .args(["learn", "--save-experience", "e.json", "--record", "r.json"])
+        .current_dir(&dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // `| head -1`: read one line, then close the pipe.
+    let mut stdout = child.stdout.take().unwrap();
+    let mut byte = [0u8; 1];
+    while stdout.read(&mut byte).unwrap() == 1 && byte[0] != b'\n' {}
+    drop(stdout);
+    let mut stderr = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut stderr)
+        .unwrap();
+    let status = child.wait().unwrap();
+    assert!(status.success(), "{status}: {stderr}");
+    assert!(!stderr.contains("panicked"), "{stderr}");
+    palc_aggregator::Experience::load(dir.join("e.json")).unwrap();
+    let record: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("r.json")).unwrap()).unwrap();
+    assert!(record.is_object());
+}
+
+fn testbed_with(dir: &Path, from: &str, to: &str) -> PathBuf {
+    let text = read("configs/testbed.toml");
+    assert!(text.contains(from), "{from}");
+    let path = dir.join("testbed.toml");
+    std::fs::write(&path, text.replace(from, to)).unwrap();
+    path
+}
+
+#[test]
+fn a_huge_position_jitter_is_refused_not_a_panic() {
+    let dir = scratch("jitter");
+    let config = testbed_with(&dir, "position_jitter_m = 0.5", "position_jitter_m = 1e308");
+    let output = palc(
+        &[
+            "traffic",
+            "simulate",
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            "t.csv",
+        ],
+        &dir,
+    );
+    // The number is short (not 300 digits) and the bound is named.
+    fails_with(&output, &["testbed.position_jitter_m", "1e308", "[0, 100]"]);
+    assert!(!dir.join("t.csv").exists());
+}
+
+#[test]
+fn too_many_lanes_are_refused() {
+    let dir = scratch("lanes");
+    let config = testbed_with(&dir, "lanes = 2", "lanes = 4294967295");
+    let output = palc(
+        &[
+            "traffic",
+            "simulate",
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            "t.csv",
+        ],
+        &dir,
+    );
+    fails_with(&output, &["road.lanes", "[1, 64]"]);
+}
+
+#[test]
+fn a_bad_dt_leaves_an_existing_csv_untouched() {
+    let dir = scratch("dt");
+    std::fs::write(dir.join("existing.csv"), "precious\n").unwrap();
+    let config = workspace_file("configs/testbed.toml");
+    for dt in ["2", "inf", "NaN", "0"] {
+        let output = palc(
+            &[
+                "traffic",
+                "simulate",
+                "--config",
+                config.to_str().unwrap(),
+                "--dt",
+                dt,
+                "--out",
+                "existing.csv",
+            ],
+            &dir,
+        );
+        fails_with(&output, &["--dt"]);
+        assert_eq!(
+            std::fs::read_to_string(dir.join("existing.csv")).unwrap(),
+            "precious\n"
+        );
+    }
+    // A good run replaces the file in full and leaves no temporary file behind.
+    succeeds(&palc(
+        &[
+            "traffic",
+            "simulate",
+            "--config",
+            config.to_str().unwrap(),
+            "--duration",
+            "1",
+            "--out",
+            "existing.csv",
+        ],
+        &dir,
+    ));
+    let names: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+    assert_eq!(names.len(), 1);
+    assert!(
+        std::fs::read_to_string(dir.join("existing.csv"))
+            .unwrap()
+            .starts_with("time,id")
+    );
+}
+
+/// The example plan problem with one replacement.
+fn plan_with(dir: &Path, from: &str, to: &str) -> Output {
+    let text = read("configs/examples/plan-problem.json");
+    assert!(text.contains(from), "{from}");
+    std::fs::write(dir.join("p.json"), text.replacen(from, to, 1)).unwrap();
+    palc(&["plan", "--problem", "p.json", "--out", "out.json"], dir)
+}
+
+#[test]
+fn plan_refuses_unknown_keys_negative_speeds_and_huge_horizons() {
+    let dir = scratch("plan");
+    let output = plan_with(&dir, "\"phi\": 0.0", "\"phi\": 0.0, \"psi\": 1.0");
+    fails_with(&output, &["unknown field `psi`"]);
+    let output = plan_with(&dir, "\"v\": 20.1168", "\"v\": -20.1168");
+    fails_with(&output, &["initial.v", "-20.1168"]);
+    let text = read("configs/examples/plan-problem.json");
+    let terminal = text.find("\"terminal\"").unwrap();
+    let (head, tail) = text.split_at(terminal);
+    let tail = tail.replacen("\"v\": ", "\"v\": -", 1);
+    std::fs::write(dir.join("p.json"), format!("{head}{tail}")).unwrap();
+    let output = palc(&["plan", "--problem", "p.json", "--out", "out.json"], &dir);
+    fails_with(&output, &["terminal.v"]);
+    let output = plan_with(&dir, "\"horizon\": 40", "\"horizon\": 1000000");
+    fails_with(
+        &output,
+        &["horizon", &palc_planner::MAX_HORIZON.to_string()],
+    );
+}
+
+#[test]
+fn zone_fit_refuses_duplicate_columns_and_names_line_and_column() {
+    let dir = scratch("zone-csv");
+    let fit = |text: &str| {
+        std::fs::write(dir.join("s.csv"), text).unwrap();
+        palc(
+            &["zone", "fit", "--samples", "s.csv", "--out", "m.json"],
+            &dir,
+        )
+    };
+    let header = "ds_p,dl_p,dist_p,ds_a,dl_a,dist_a,y\n";
+    let output = fit("ds_p,dl_p,dist_p,ds_a,dl_a,dist_a,y,ds_p\n1,2,3,4,5,6,1,9\n");
+    fails_with(&output, &["`ds_p` appears twice"]);
+    let output = fit(&format!("{header}1,2,3,4,5,6,1\n1,2,inf,4,5,6,0\n"));
+    fails_with(&output, &["line 3", "`dist_p`", "inf"]);
+    assert!(!dir.join("m.json").exists());
+}
+
+#[test]
+fn a_zone_config_error_is_blamed_on_the_config() {
+    let dir = scratch("zone-config");
+    std::fs::write(dir.join("zone.toml"), "ridge = -1.0\n").unwrap();
+    let samples = workspace_file("configs/examples/zone-samples.csv");
+    let output = palc(
+        &[
+            "zone",
+            "fit",
+            "--samples",
+            samples.to_str().unwrap(),
+            "--config",
+            "zone.toml",
+            "--out",
+            "m.json",
+        ],
+        &dir,
+    );
+    fails_with(&output, &["zone.toml", "ridge"]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("zone-samples.csv"), "{stderr}");
+}
+
+fn learn_with(dir: &Path, from: &str, to: &str) -> Output {
+    let text = read("configs/learn.toml");
+    assert!(text.contains(from), "{from}");
+    std::fs::write(dir.join("learn.toml"), text.replacen(from, to, 1)).unwrap();
+    palc(&["learn", "--config", "learn.toml"], dir)
+}
+
+#[test]
+fn learn_bounds_the_loop_and_names_a_missing_table() {
+    let dir = scratch("learn");
+    let output = learn_with(&dir, "success_streak = 3", "success_streak = 1000000");
+    fails_with(&output, &["loop.success_streak", "[1, 100]", "learn.toml"]);
+    let output = learn_with(&dir, "max_takeovers = 30", "max_takeovers = 1000000");
+    fails_with(&output, &["loop.max_takeovers"]);
+    let output = learn_with(&dir, "max_takeovers = 30", "max_lane_changes = 1000000");
+    fails_with(&output, &["loop.max_lane_changes"]);
+    let output = learn_with(&dir, "style = \"neutral\"", "style = \"custom\"");
+    fails_with(&output, &["[user.custom] is missing"]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("NaN"), "{stderr}");
+}
+
+#[cfg(unix)]
+#[test]
+fn a_saved_experience_keeps_its_permissions_and_its_symlink() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = scratch("experience-permissions");
+    std::fs::create_dir(dir.join("store")).unwrap();
+    std::fs::write(dir.join("store/e.json"), "old").unwrap();
+    std::fs::set_permissions(
+        dir.join("store/e.json"),
+        std::fs::Permissions::from_mode(0o600),
+    )
+    .unwrap();
+    std::os::unix::fs::symlink("store/e.json", dir.join("e.json")).unwrap();
+    succeeds(&palc(&["learn", "--save-experience", "e.json"], &dir));
+    let link = std::fs::symlink_metadata(dir.join("e.json")).unwrap();
+    assert!(link.file_type().is_symlink());
+    let target = std::fs::metadata(dir.join("store/e.json")).unwrap();
+    assert_eq!(target.permissions().mode() & 0o777, 0o600);
+    palc_aggregator::Experience::load(dir.join("store/e.json")).unwrap();
+}
