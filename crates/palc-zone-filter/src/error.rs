@@ -66,6 +66,14 @@ pub enum ZoneError {
         /// Which point overflowed.
         what: String,
     },
+    /// Finite samples whose mean or scatter overflowed (e.g. features near 1e308).
+    #[error(
+        "the statistics of the {class} samples overflowed (a mean or scatter entry is not finite); features must stay below about 1e150 in magnitude"
+    )]
+    StatisticsOverflow {
+        /// `safe` or `unsafe`.
+        class: &'static str,
+    },
     /// A stored model was written by an unsupported format version.
     #[error("model format version {found} is not supported; this build reads version {expected}")]
     UnsupportedVersion {

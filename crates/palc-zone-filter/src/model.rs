@@ -72,7 +72,8 @@ impl ZoneModel {
     ///
     /// # Errors
     /// [`ZoneError::DimensionMismatch`] or [`ZoneError::NonFinite`] for a bad
-    /// sample, [`ZoneError::SingularCovariance`] if the eigendecomposition of
+    /// sample, [`ZoneError::StatisticsOverflow`] if finite samples overflow the
+    /// mean or scatter, [`ZoneError::SingularCovariance`] if the eigendecomposition of
     /// a covariance fails (a singular covariance is not an error: its null
     /// directions get weight 0).
     pub fn update(&mut self, samples: &[Sample]) -> Result<(), ZoneError> {
@@ -90,6 +91,12 @@ impl ZoneModel {
         let mut unsafe_ = self.unsafe_.clone();
         safe.merge(&ClassStatistics::from_points(d, of_class(Label::Safe)));
         unsafe_.merge(&ClassStatistics::from_points(d, of_class(Label::Unsafe)));
+        for (class, statistics) in [("safe", &safe), ("unsafe", &unsafe_)] {
+            let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+            if !(finite(&statistics.mean) && finite(&statistics.scatter)) {
+                return Err(ZoneError::StatisticsOverflow { class });
+            }
+        }
         let fitted = fit_parameters(&self.config, &safe, &unsafe_)?;
         self.safe = safe;
         self.unsafe_ = unsafe_;

@@ -406,3 +406,21 @@ fn labels_are_zero_or_one() {
     assert_eq!(serde_json::from_str::<Label>("0").unwrap(), Label::Unsafe);
     assert!(serde_json::from_str::<Label>("2").is_err());
 }
+
+#[test]
+fn finite_samples_whose_statistics_overflow_are_refused_and_change_nothing() {
+    // 1e308 is finite, but the mean of two such values and their squares are not.
+    let mut samples = samples_at(FeatureSet::Paper, 0.0, &[0.0, 1.0, 2.0], Label::Safe);
+    for value in [1e308, 1.5e308] {
+        let mut x = features_at(FeatureSet::Paper, 0.0, 3.0);
+        x[0] = value;
+        samples.push(Sample::new(x, Label::Unsafe));
+    }
+    let mut model = ZoneModel::new(ZoneConfig::default()).unwrap();
+    assert_eq!(
+        model.update(&samples),
+        Err(ZoneError::StatisticsOverflow { class: "unsafe" })
+    );
+    assert!(!model.is_informative());
+    assert_eq!(model.unsafe_statistics().count, 0);
+}
