@@ -61,7 +61,7 @@
 //! assert!(after <= before);
 //! # Ok::<(), palc_aggregator::AggregatorError>(())
 //! ```
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 mod convex;

@@ -26,7 +26,7 @@
 //! Results do not depend on the number of threads: runs are collected by index,
 //! and every random draw comes from a seed of the config. The crate prints
 //! nothing; progress goes to a [`Progress`] that the caller supplies.
-#![warn(missing_docs)]
+#![deny(missing_docs)]
 #![warn(clippy::print_stdout, clippy::print_stderr)]
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 

@@ -1,5 +1,7 @@
 //! What every QP backend returns to the planner.
 
+use crate::SolverFailure;
+
 /// How a backend finished, in backend-neutral terms.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum RawStatus {
@@ -9,10 +11,12 @@ pub(crate) enum RawStatus {
     AlmostSolved,
     /// A certificate of primal infeasibility was found (in `RawSolution::z`).
     PrimalInfeasible,
-    /// A certificate of dual infeasibility (an unbounded direction) was found.
+    /// A certificate of dual infeasibility (an unbounded direction) was found; only
+    /// clarabel looks for one.
+    #[cfg_attr(not(feature = "clarabel"), allow(dead_code))]
     DualInfeasible,
-    /// Stopped without a solution; the string names the reason.
-    Failed(String),
+    /// Stopped without a solution.
+    Failed(SolverFailure),
 }
 
 /// Raw result of one solve, in the variable and row order of [`QpData`](crate::qp::QpData).

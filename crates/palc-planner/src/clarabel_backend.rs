@@ -6,7 +6,7 @@ use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, S
 
 use crate::backend::{RawSolution, RawStatus};
 use crate::qp::{CscPattern, Pattern, QpData};
-use crate::{PlanError, SolverSettings};
+use crate::{NumericalCause, PlanError, SolverFailure, SolverSettings};
 
 struct Cached {
     pattern: Pattern,
@@ -108,8 +108,8 @@ impl ClarabelBackend {
                 &cones,
                 settings(solver_settings),
             )
-            .map_err(|e| PlanError::SolverFailed {
-                status: format!("setup error: {e}"),
+            .map_err(|_| PlanError::SolverFailed {
+                status: NumericalCause::ClarabelRefused.into(),
                 iterations: 0,
             })?;
             self.cached = Some(Cached {
@@ -135,7 +135,15 @@ impl ClarabelBackend {
             SolverStatus::DualInfeasible | SolverStatus::AlmostDualInfeasible => {
                 RawStatus::DualInfeasible
             }
-            other => RawStatus::Failed(format!("{other:?}")),
+            SolverStatus::MaxIterations => RawStatus::Failed(SolverFailure::MaxIterations),
+            SolverStatus::MaxTime => RawStatus::Failed(SolverFailure::MaxTime),
+            SolverStatus::InsufficientProgress => {
+                RawStatus::Failed(SolverFailure::InsufficientProgress)
+            }
+            SolverStatus::NumericalError => RawStatus::Failed(NumericalCause::Factorization.into()),
+            SolverStatus::Unsolved | SolverStatus::CallbackTerminated => {
+                RawStatus::Failed(NumericalCause::ClarabelRefused.into())
+            }
         };
         Ok(RawSolution {
             status,

@@ -1,5 +1,6 @@
 //! Planner configuration: horizon, step, vehicle, extra cost terms and solver settings.
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use crate::ConfigError;
@@ -8,8 +9,12 @@ use crate::ConfigError;
 pub const MAX_HORIZON: usize = 10_000;
 
 /// How the lateral bounds of Eq. (22) enter the QP.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case", deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    serde(rename_all = "snake_case", deny_unknown_fields)
+)]
 #[non_exhaustive]
 pub enum LateralBoundsMode {
     /// Hard constraints, as in the paper; inconsistent zones are refused as infeasible.
@@ -28,8 +33,9 @@ pub enum LateralBoundsMode {
 /// The QP backend. Both solve the same assembled QP and return the same [`Plan`](crate::Plan)
 /// and [`PlanError`](crate::PlanError)s (one exception: the Riccati backend does not look
 /// for a certificate of unboundedness, see docs/paper-mapping.md).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 #[non_exhaustive]
 pub enum Backend {
     /// A Mehrotra predictor-corrector interior point whose Newton systems are solved by
@@ -42,7 +48,9 @@ pub enum Backend {
     #[default]
     Riccati,
     /// The general sparse interior-point solver of the `clarabel` crate, kept as the
-    /// reference.
+    /// reference. It needs the `clarabel` cargo feature (on by default); without it,
+    /// [`PlannerConfig::validate`] and [`Planner::new`](crate::Planner::new) refuse it
+    /// with [`ConfigError::BackendUnavailable`].
     Clarabel,
 }
 
@@ -52,8 +60,9 @@ pub enum Backend {
 ///
 /// [`PlannerConfig::validate`] holds every number to a documented range:
 /// `max_iter` in [`MAX_ITER_RANGE`], each tolerance in [`TOLERANCE_RANGE`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
 pub struct SolverSettings {
     /// Maximum interior-point iterations, in [`MAX_ITER_RANGE`].
     pub max_iter: u32,
@@ -103,8 +112,9 @@ impl Default for SolverSettings {
 }
 
 /// Everything about the planner that stays fixed between plans.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(default, deny_unknown_fields))]
 pub struct PlannerConfig {
     /// Horizon `K` (number of stages); states are `X_0..X_K`.
     pub horizon: usize,
@@ -222,6 +232,12 @@ impl PlannerConfig {
                 TOLERANCE_RANGE.contains(&value),
                 "in [1e-14, 1e-2]",
             )?;
+        }
+        if self.backend == Backend::Clarabel && !cfg!(feature = "clarabel") {
+            return Err(ConfigError::BackendUnavailable {
+                backend: "clarabel",
+                feature: "clarabel",
+            });
         }
         Ok(())
     }

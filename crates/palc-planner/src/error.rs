@@ -19,6 +19,16 @@ pub enum ConfigError {
         /// The allowed range, in words.
         bound: &'static str,
     },
+    /// The chosen backend was not compiled in: its cargo feature is off.
+    #[error(
+        "config field `backend` = {backend} needs the `{feature}` feature of palc-planner, which is off; enable it or use `riccati`"
+    )]
+    BackendUnavailable {
+        /// The backend, as spelled in a configuration file, e.g. `clarabel`.
+        backend: &'static str,
+        /// The cargo feature that provides it.
+        feature: &'static str,
+    },
 }
 
 /// Sets of steps, printed as `3..=7, 10`.
@@ -84,6 +94,12 @@ pub enum PlanError {
         expected: usize,
         /// Given length.
         found: usize,
+    },
+    /// A [`ProblemBuilder`](crate::ProblemBuilder) was built without a required input.
+    #[error("`{field}` was not given; set it on the problem builder")]
+    MissingField {
+        /// The input, e.g. `initial`.
+        field: &'static str,
     },
     /// An input number is NaN or infinite.
     #[error("`{field}` is {value}, expected a finite number")]
@@ -160,9 +176,126 @@ pub enum PlanError {
     /// The solver stopped without a solution.
     #[error("qp solver failed with status {status} after {iterations} iterations")]
     SolverFailed {
-        /// The solver's status.
-        status: String,
+        /// Why it stopped, in the same terms for both backends.
+        status: SolverFailure,
         /// Iterations done.
         iterations: u32,
+    },
+}
+
+/// Why a QP backend stopped without a solution; both backends report the same reasons.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
+#[non_exhaustive]
+pub enum SolverFailure {
+    /// `solver.max_iter` iterations were done without meeting the tolerances.
+    #[error("max iterations")]
+    MaxIterations,
+    /// The iterates stopped improving before meeting even the reduced tolerances of
+    /// `AlmostSolved` (the Riccati backend: three steps in a row shorter than 1e-8, or
+    /// no better iterate for a while; clarabel: its own rule).
+    #[error("insufficient progress")]
+    InsufficientProgress,
+    /// clarabel's time limit was reached (the planner sets none; kept for completeness).
+    #[error("time limit")]
+    MaxTime,
+    /// A numerical failure, with its cause.
+    #[error("numerical failure: {0}")]
+    Numerical(#[from] NumericalCause),
+}
+
+/// The cause of a [`SolverFailure::Numerical`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
+#[non_exhaustive]
+pub enum NumericalCause {
+    /// The Riccati recursion met a reduced control block `R̄_i` that is not positive
+    /// definite (non-convex or non-finite data).
+    #[error("control block of step {step} not positive definite")]
+    ControlBlock {
+        /// The step `i`.
+        step: usize,
+    },
+    /// The Riccati recursion's terminal Schur complement is not positive definite even
+    /// after regularization.
+    #[error("terminal schur complement not positive definite")]
+    TerminalSchur,
+    /// clarabel's KKT factorization failed (its `NumericalError`).
+    #[error("kkt factorization failed")]
+    Factorization,
+    /// clarabel refused the QP or the settings when the solver was built, or stopped
+    /// without a status (`Unsolved`, `CallbackTerminated`).
+    #[error("clarabel refused the problem")]
+    ClarabelRefused,
+    /// The assembled QP does not have the stage layout the Riccati backend reads (a bug
+    /// in the assembly, never a property of the input).
+    #[error("assembled qp is not in stage form: {0}")]
+    StageLayout(#[from] LayoutError),
+}
+
+/// Where the assembled QP departs from the stage form of Eqs. (9)-(23) that the
+/// Riccati backend reads; a bug in the assembly, never a property of the input.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Error)]
+#[non_exhaustive]
+pub enum LayoutError {
+    /// The QP has the wrong number of variables or equality rows for `K`.
+    #[error("unexpected qp size n = {n}, m_eq = {m_eq} for K = {horizon}")]
+    Size {
+        /// Variables.
+        n: usize,
+        /// Equality rows.
+        m_eq: usize,
+        /// Horizon `K`.
+        horizon: usize,
+    },
+    /// A Hessian entry couples two stages or involves a slack.
+    #[error("hessian entry ({row}, {col}) couples two stages")]
+    CoupledHessian {
+        /// Row.
+        row: usize,
+        /// Column.
+        col: usize,
+    },
+    /// An equality row involves a slack.
+    #[error("equality row {row} involves a slack")]
+    SlackInEquality {
+        /// Row.
+        row: usize,
+    },
+    /// An initial row is not `X_0[row] = x0` (Eq. 20).
+    #[error("initial row {row} is not X_0[{row}] = x0")]
+    InitialRow {
+        /// Row.
+        row: usize,
+    },
+    /// A dynamics row does not have the form `X_{i+1} = A_i X_i + B_i U_i + c_i`.
+    #[error("dynamics row {row} does not have the form X_(i+1) = A_i X_i + B_i U_i + c_i")]
+    DynamicsRow {
+        /// Row.
+        row: usize,
+    },
+    /// A row of the terminal condition (Eq. 21) involves a stage other than `K`.
+    #[error("terminal row {row} involves stage {stage}")]
+    TerminalRow {
+        /// Row.
+        row: usize,
+        /// The stage.
+        stage: usize,
+    },
+    /// An inequality row holds more than one stage variable or more than one slack.
+    #[error("inequality row {row} has more than one variable of a kind")]
+    InequalityRow {
+        /// Row (after the equality rows).
+        row: usize,
+    },
+    /// A slack is in too many rows, tied to two stage variables, or in no row.
+    #[error("slack {slack} is not in one or two rows on one stage variable")]
+    Slack {
+        /// The slack's index.
+        slack: usize,
+    },
+    /// A softly bounded variable also has a hard bound.
+    #[error("row {row} bounds a softly bounded variable without its slack")]
+    HardRowOnSoftVariable {
+        /// Row (after the equality rows).
+        row: usize,
     },
 }

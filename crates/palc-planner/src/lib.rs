@@ -25,37 +25,32 @@
 //! Pass `s` relative to the ego's position at the start of the plan (`initial.s = 0`)
 //! so that the `s δ` feature (w7) does not depend on where on the road the plan begins.
 //!
-//! ```
-//! use palc_planner::{
-//!     LateralBound, Planner, PlannerConfig, Position, Problem, State, Terminal, Weights,
-//! };
+//! Build the problem with [`Problem::builder`] (each input checked as it is given) or as
+//! a struct literal; name the weights of a stage with [`StageWeights`].
 //!
-//! let config = PlannerConfig { horizon: 40, dt: 0.1, ..PlannerConfig::default() };
-//! let k = config.horizon;
-//! let speed = 20.0;
-//! let problem = Problem {
-//!     initial: State { s: 0.0, v: speed, l: 0.0, phi: 0.0 },
-//!     reference_speed: vec![speed; k],
-//!     curvature: 0.0,
-//!     // w1 = 0.1 (stay near l = 0 unless pulled), w3 = 1, w8 = 10 (smooth steering).
-//!     weights: Weights::constant(k, [0.1, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 10.0, 0.0, 0.0]),
-//!     preceding: (0..k).map(|i| Position { s: 30.0 + 18.0 * 0.1 * i as f64, l: 0.0 }).collect(),
-//!     adjacent: (0..k).map(|i| Position { s: -20.0 + 22.0 * 0.1 * i as f64, l: 3.5 }).collect(),
-//!     terminal: Terminal { s: None, v: speed, l: 3.5 },
-//!     lateral_bounds: vec![Some(LateralBound::new(-1.75, 5.25)); k + 1],
-//!     tracking: None,
-//! };
-//! let mut planner = Planner::new(config)?;
-//! let plan = planner.plan(&problem)?;
-//! assert!((plan.states[k].l - 3.5).abs() < 1e-6);
-//! let w_phi = problem.weights.dot(&plan.features).unwrap();
-//! assert!((plan.objective - (w_phi + plan.extras.total())).abs() < 1e-6 * (1.0 + plan.objective.abs()));
-//! # Ok::<(), palc_planner::PlanError>(())
+//! # Features
+//!
+//! - `clarabel` (default): the reference backend [`Backend::Clarabel`]. Without it the
+//!   crate has no solver dependency, and [`PlannerConfig::validate`] refuses
+//!   `Backend::Clarabel` with [`ConfigError::BackendUnavailable`].
+//! - `serde` (default): `Serialize` and `Deserialize` for the configuration, problem and
+//!   plan types.
+//!
+//! # Example
+//!
+//! A lane change with hard and with soft lateral bounds, printed as CSV; this is
+//! `examples/plan_lane_change.rs` (`cargo run -p palc-planner --example
+//! plan_lane_change`), run here as a doctest.
+//!
 //! ```
-#![warn(missing_docs)]
+#![doc = include_str!("../examples/plan_lane_change.rs")]
+//! ```
+#![deny(missing_docs)]
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 mod backend;
+mod builder;
+#[cfg(feature = "clarabel")]
 mod clarabel_backend;
 mod config;
 mod convexity;
@@ -68,15 +63,16 @@ mod riccati;
 mod validate;
 mod weights;
 
+pub use builder::ProblemBuilder;
 pub use config::{
     Backend, LateralBoundsMode, MAX_HORIZON, MAX_ITER_RANGE, PlannerConfig, SolverSettings,
     TOLERANCE_RANGE,
 };
 pub use convexity::check_convexity;
-pub use error::{ConfigError, PlanError, StepRanges};
+pub use error::{ConfigError, LayoutError, NumericalCause, PlanError, SolverFailure, StepRanges};
 pub use features::{features, stage_features};
 pub use planner::{Extras, Plan, Planner, SolveStats, SolveStatus};
 pub use problem::{
     Control, LateralBound, MAX_POSITION, Position, Problem, State, Terminal, Tracking,
 };
-pub use weights::{FEATURE_COUNT, Features, Weights, feature};
+pub use weights::{FEATURE_COUNT, Features, StageWeights, Weights, feature};

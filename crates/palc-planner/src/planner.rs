@@ -1,8 +1,10 @@
 //! The planner: validation, QP assembly, solve, and the plan with its features.
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use crate::backend::RawStatus;
+#[cfg(feature = "clarabel")]
 use crate::clarabel_backend::ClarabelBackend;
 use crate::qp::{QpData, RowTag, control_index, pattern_of, state_index};
 use crate::riccati::RiccatiBackend;
@@ -13,7 +15,8 @@ use crate::{
 };
 
 /// The extra cost terms added to `w · Φ` (documented in docs/paper-mapping.md).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Extras {
     /// `ρ_a Σ_{i=0}^{K-1} a_i²`.
     pub acceleration: f64,
@@ -31,8 +34,9 @@ impl Extras {
 }
 
 /// How the solver finished.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 #[non_exhaustive]
 pub enum SolveStatus {
     /// Solved to the requested tolerances.
@@ -42,7 +46,8 @@ pub enum SolveStatus {
 }
 
 /// Statistics of one plan.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct SolveStats {
     /// Solver status.
     pub status: SolveStatus,
@@ -59,7 +64,8 @@ pub struct SolveStats {
 }
 
 /// An optimal lane-change trajectory.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Plan {
     /// `X_0..X_K`.
     pub states: Vec<State>,
@@ -86,6 +92,7 @@ pub struct Plan {
 pub struct Planner {
     config: PlannerConfig,
     data: QpData,
+    #[cfg(feature = "clarabel")]
     clarabel: ClarabelBackend,
     riccati: RiccatiBackend,
 }
@@ -97,6 +104,7 @@ impl Planner {
         Ok(Self {
             config,
             data: QpData::default(),
+            #[cfg(feature = "clarabel")]
             clarabel: ClarabelBackend::default(),
             riccati: RiccatiBackend::default(),
         })
@@ -122,9 +130,19 @@ impl Planner {
                 self.config.horizon,
                 &self.config.solver,
             )?,
+            #[cfg(feature = "clarabel")]
             Backend::Clarabel => self
                 .clarabel
                 .solve(&self.data, pattern, &self.config.solver)?,
+            // `Planner::new` validated the configuration, which refuses this backend.
+            #[cfg(not(feature = "clarabel"))]
+            Backend::Clarabel => {
+                return Err(crate::ConfigError::BackendUnavailable {
+                    backend: "clarabel",
+                    feature: "clarabel",
+                }
+                .into());
+            }
         };
         let status = match raw.status {
             RawStatus::Solved => SolveStatus::Solved,

@@ -1,13 +1,15 @@
 //! The input of one plan: initial state, reference speeds, weights, predicted
 //! vehicles, terminal state, lateral bounds and an optional tracking term.
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use crate::Weights;
 
 /// The state `X_i = [s, v, l, φ]` of Eq. (9), in the order of NOTES item 3.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct State {
     /// Longitudinal (Frenet) position (m).
     pub s: f64,
@@ -37,8 +39,9 @@ impl State {
 }
 
 /// The control `U_i = [a, δ]` of Eq. (10).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Control {
     /// Longitudinal acceleration (m/s²).
     pub a: f64,
@@ -47,8 +50,9 @@ pub struct Control {
 }
 
 /// A predicted position of another vehicle in the Frenet frame.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Position {
     /// Longitudinal position (m), in the same origin as the ego's `s`.
     pub s: f64,
@@ -57,12 +61,13 @@ pub struct Position {
 }
 
 /// The terminal condition of Eq. (21): `X_K = [s_K, v_K, l_K, 0]`.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Terminal {
     /// Target longitudinal position; `None` leaves `s_K` free (the paper fixes it,
     /// but a caller rarely knows it in advance).
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub s: Option<f64>,
     /// Target speed after the lane change (m/s).
     pub v: f64,
@@ -71,14 +76,15 @@ pub struct Terminal {
 }
 
 /// Lateral bounds at one step (Eq. 22); either side may be absent.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct LateralBound {
     /// Lowest allowed `l` (m); `None` means unbounded below.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub min: Option<f64>,
     /// Highest allowed `l` (m); `None` means unbounded above.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub max: Option<f64>,
 }
 
@@ -94,8 +100,9 @@ impl LateralBound {
 
 /// The tracking term `Σ_i (X_i - X_i^ref)ᵀ Q^p (X_i - X_i^ref)` (the form of Eq. 25),
 /// with diagonal `Q^p`; the aggregator plans expert trajectories with it.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Tracking {
     /// Diagonal of `Q^p` for `[s, v, l, φ]`; each entry must be `>= 0`.
     /// Eq. (26) tracks only `l`: `[0, 0, q_l, 0]`.
@@ -120,8 +127,9 @@ pub const MAX_POSITION: f64 = 1e9;
 /// other vehicles shifted by the same amount): the feature `s δ` (w7) then does not
 /// depend on where on the road the plan begins. The planner itself takes `s` as given,
 /// assembles its QP relative to `initial.s` and refuses `|s| >` [`MAX_POSITION`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Problem {
     /// `X_0` of Eq. (20).
     pub initial: State,
@@ -129,7 +137,7 @@ pub struct Problem {
     /// dynamics are linearized (Eqs. 12-14); must be `>= 0`.
     pub reference_speed: Vec<f64>,
     /// Road curvature `R` (1/m) of Eq. (14); 0 on a straight road.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub curvature: f64,
     /// The 10 x K weight matrix of Eq. (15).
     pub weights: Weights,
@@ -142,6 +150,6 @@ pub struct Problem {
     /// Lateral bounds per step `i = 0..=K` (length `K + 1`), `None` for no bound.
     pub lateral_bounds: Vec<Option<LateralBound>>,
     /// Optional tracking term (form of Eq. 25).
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub tracking: Option<Tracking>,
 }

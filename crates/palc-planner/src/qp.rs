@@ -268,7 +268,9 @@ pub(crate) fn pattern_of(problem: &Problem) -> Pattern {
 }
 
 /// A compressed-sparse-column pattern built once from triplets, with the position of
-/// each triplet in `nzval` (duplicates share a position and are summed).
+/// each triplet in `nzval` (duplicates share a position and are summed); only the
+/// clarabel backend reads the QP in this form.
+#[cfg(feature = "clarabel")]
 #[derive(Debug, Clone)]
 pub(crate) struct CscPattern {
     pub m: usize,
@@ -278,6 +280,7 @@ pub(crate) struct CscPattern {
     pub slot_of_triplet: Vec<usize>,
 }
 
+#[cfg(feature = "clarabel")]
 impl CscPattern {
     pub fn new(m: usize, n: usize, rows: &[usize], cols: &[usize]) -> Self {
         let mut order: Vec<usize> = (0..rows.len()).collect();

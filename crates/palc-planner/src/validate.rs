@@ -1,10 +1,11 @@
 //! Checks of a [`Problem`] against a [`PlannerConfig`] before any QP is built.
 
 use crate::{
-    LateralBoundsMode, MAX_POSITION, PlanError, PlannerConfig, Problem, StepRanges, check_convexity,
+    LateralBound, LateralBoundsMode, MAX_POSITION, PlanError, PlannerConfig, Position, Problem,
+    State, StepRanges, Terminal, Tracking, Weights, check_convexity,
 };
 
-fn finite(field: impl FnOnce() -> String, value: f64) -> Result<(), PlanError> {
+pub(crate) fn finite(field: impl FnOnce() -> String, value: f64) -> Result<(), PlanError> {
     if value.is_finite() {
         Ok(())
     } else {
@@ -15,7 +16,7 @@ fn finite(field: impl FnOnce() -> String, value: f64) -> Result<(), PlanError> {
     }
 }
 
-fn length(field: &'static str, expected: usize, found: usize) -> Result<(), PlanError> {
+pub(crate) fn length(field: &'static str, expected: usize, found: usize) -> Result<(), PlanError> {
     if expected == found {
         Ok(())
     } else {
@@ -25,6 +26,104 @@ fn length(field: &'static str, expected: usize, found: usize) -> Result<(), Plan
             found,
         })
     }
+}
+
+const STATE_NAMES: [&str; 4] = ["s", "v", "l", "phi"];
+
+/// Every component of a state finite.
+pub(crate) fn finite_state(name: &str, state: &State) -> Result<(), PlanError> {
+    for (c, x) in state.to_array().into_iter().enumerate() {
+        finite(|| format!("{name}.{}", STATE_NAMES[c]), x)?;
+    }
+    Ok(())
+}
+
+/// Every reference speed finite and `>= 0` (Eqs. 12-14).
+pub(crate) fn check_reference_speed(speeds: &[f64]) -> Result<(), PlanError> {
+    for (i, &v) in speeds.iter().enumerate() {
+        finite(|| format!("reference_speed[{i}]"), v)?;
+        if v < 0.0 {
+            return Err(PlanError::OutOfRange {
+                field: format!("reference_speed[{i}]"),
+                value: v,
+                bound: ">= 0",
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Every weight finite.
+pub(crate) fn finite_weights(weights: &Weights) -> Result<(), PlanError> {
+    for (column, w) in weights.columns().iter().enumerate() {
+        for (row, &x) in w.iter().enumerate() {
+            finite(|| format!("weights[{column}][{row}]"), x)?;
+        }
+    }
+    Ok(())
+}
+
+/// Every predicted position finite.
+pub(crate) fn finite_positions(name: &str, positions: &[Position]) -> Result<(), PlanError> {
+    for (i, p) in positions.iter().enumerate() {
+        finite(|| format!("{name}[{i}].s"), p.s)?;
+        finite(|| format!("{name}[{i}].l"), p.l)?;
+    }
+    Ok(())
+}
+
+/// A speed of the ego `>= 0`: the model drives forwards only.
+pub(crate) fn forward_speed(field: &'static str, v: f64) -> Result<(), PlanError> {
+    if v < 0.0 {
+        return Err(PlanError::OutOfRange {
+            field: field.into(),
+            value: v,
+            bound: ">= 0 (the model drives forwards only)",
+        });
+    }
+    Ok(())
+}
+
+/// Every given terminal component finite.
+pub(crate) fn finite_terminal(t: &Terminal) -> Result<(), PlanError> {
+    if let Some(s) = t.s {
+        finite(|| "terminal.s".into(), s)?;
+    }
+    finite(|| "terminal.v".into(), t.v)?;
+    finite(|| "terminal.l".into(), t.l)
+}
+
+/// Every given lateral bound finite.
+pub(crate) fn finite_lateral_bounds(bounds: &[Option<LateralBound>]) -> Result<(), PlanError> {
+    for (i, b) in bounds.iter().enumerate() {
+        let Some(b) = b else { continue };
+        if let Some(min) = b.min {
+            finite(|| format!("lateral_bounds[{i}].min"), min)?;
+        }
+        if let Some(max) = b.max {
+            finite(|| format!("lateral_bounds[{i}].max"), max)?;
+        }
+    }
+    Ok(())
+}
+
+/// Tracking weights finite and `>= 0`, reference states finite.
+pub(crate) fn check_tracking(tracking: &Tracking) -> Result<(), PlanError> {
+    for (c, &q) in tracking.weights.iter().enumerate() {
+        finite(|| format!("tracking.weights[{c}]"), q)?;
+        if q < 0.0 {
+            return Err(PlanError::OutOfRange {
+                field: format!("tracking.weights[{c}]"),
+                value: q,
+                bound: ">= 0",
+            });
+        }
+    }
+    for (i, r) in tracking.reference.iter().enumerate() {
+        let Some(r) = r else { continue };
+        finite_state(&format!("tracking.reference[{i}]"), r)?;
+    }
+    Ok(())
 }
 
 /// Dimensions, finiteness, ranges, convexity and, for hard bounds, the infeasibilities
@@ -40,76 +139,18 @@ pub(crate) fn validate_problem(config: &PlannerConfig, problem: &Problem) -> Res
         length("tracking.reference", k + 1, tracking.reference.len())?;
     }
 
-    let names = ["s", "v", "l", "phi"];
-    for (c, x) in problem.initial.to_array().into_iter().enumerate() {
-        finite(|| format!("initial.{}", names[c]), x)?;
-    }
+    finite_state("initial", &problem.initial)?;
     finite(|| "curvature".into(), problem.curvature)?;
-    for (i, &v) in problem.reference_speed.iter().enumerate() {
-        finite(|| format!("reference_speed[{i}]"), v)?;
-        if v < 0.0 {
-            return Err(PlanError::OutOfRange {
-                field: format!("reference_speed[{i}]"),
-                value: v,
-                bound: ">= 0",
-            });
-        }
-    }
-    for (column, w) in problem.weights.columns().iter().enumerate() {
-        for (row, &x) in w.iter().enumerate() {
-            finite(|| format!("weights[{column}][{row}]"), x)?;
-        }
-    }
-    for (name, positions) in [
-        ("preceding", &problem.preceding),
-        ("adjacent", &problem.adjacent),
-    ] {
-        for (i, p) in positions.iter().enumerate() {
-            finite(|| format!("{name}[{i}].s"), p.s)?;
-            finite(|| format!("{name}[{i}].l"), p.l)?;
-        }
-    }
-    let t = &problem.terminal;
-    if let Some(s) = t.s {
-        finite(|| "terminal.s".into(), s)?;
-    }
-    finite(|| "terminal.v".into(), t.v)?;
-    finite(|| "terminal.l".into(), t.l)?;
-    for (field, v) in [("initial.v", problem.initial.v), ("terminal.v", t.v)] {
-        if v < 0.0 {
-            return Err(PlanError::OutOfRange {
-                field: field.into(),
-                value: v,
-                bound: ">= 0 (the model drives forwards only)",
-            });
-        }
-    }
-    for (i, b) in problem.lateral_bounds.iter().enumerate() {
-        let Some(b) = b else { continue };
-        if let Some(min) = b.min {
-            finite(|| format!("lateral_bounds[{i}].min"), min)?;
-        }
-        if let Some(max) = b.max {
-            finite(|| format!("lateral_bounds[{i}].max"), max)?;
-        }
-    }
+    check_reference_speed(&problem.reference_speed)?;
+    finite_weights(&problem.weights)?;
+    finite_positions("preceding", &problem.preceding)?;
+    finite_positions("adjacent", &problem.adjacent)?;
+    finite_terminal(&problem.terminal)?;
+    forward_speed("initial.v", problem.initial.v)?;
+    forward_speed("terminal.v", problem.terminal.v)?;
+    finite_lateral_bounds(&problem.lateral_bounds)?;
     if let Some(tracking) = &problem.tracking {
-        for (c, &q) in tracking.weights.iter().enumerate() {
-            finite(|| format!("tracking.weights[{c}]"), q)?;
-            if q < 0.0 {
-                return Err(PlanError::OutOfRange {
-                    field: format!("tracking.weights[{c}]"),
-                    value: q,
-                    bound: ">= 0",
-                });
-            }
-        }
-        for (i, r) in tracking.reference.iter().enumerate() {
-            let Some(r) = r else { continue };
-            for (c, x) in r.to_array().into_iter().enumerate() {
-                finite(|| format!("tracking.reference[{i}].{}", names[c]), x)?;
-            }
-        }
+        check_tracking(tracking)?;
     }
 
     check_positions(problem)?;
@@ -121,35 +162,37 @@ pub(crate) fn validate_problem(config: &PlannerConfig, problem: &Problem) -> Res
     Ok(())
 }
 
+/// A longitudinal position within [`MAX_POSITION`] of the origin.
+pub(crate) fn within_max_position(field: impl FnOnce() -> String, s: f64) -> Result<(), PlanError> {
+    if s.abs() <= MAX_POSITION {
+        Ok(())
+    } else {
+        Err(PlanError::OutOfRange {
+            field: field(),
+            value: s,
+            bound: "within 1e9 m of the origin (pass s relative to the ego)",
+        })
+    }
+}
+
 /// Every longitudinal position within [`MAX_POSITION`] of the origin.
 fn check_positions(problem: &Problem) -> Result<(), PlanError> {
-    let check = |field: &dyn Fn() -> String, s: f64| {
-        if s.abs() <= MAX_POSITION {
-            Ok(())
-        } else {
-            Err(PlanError::OutOfRange {
-                field: field(),
-                value: s,
-                bound: "within 1e9 m of the origin (pass s relative to the ego)",
-            })
-        }
-    };
-    check(&|| "initial.s".into(), problem.initial.s)?;
+    within_max_position(|| "initial.s".into(), problem.initial.s)?;
     for (name, positions) in [
         ("preceding", &problem.preceding),
         ("adjacent", &problem.adjacent),
     ] {
         for (i, p) in positions.iter().enumerate() {
-            check(&|| format!("{name}[{i}].s"), p.s)?;
+            within_max_position(|| format!("{name}[{i}].s"), p.s)?;
         }
     }
     if let Some(s) = problem.terminal.s {
-        check(&|| "terminal.s".into(), s)?;
+        within_max_position(|| "terminal.s".into(), s)?;
     }
     if let Some(tracking) = &problem.tracking {
         for (i, r) in tracking.reference.iter().enumerate() {
             if let Some(r) = r {
-                check(&|| format!("tracking.reference[{i}].s"), r.s)?;
+                within_max_position(|| format!("tracking.reference[{i}].s"), r.s)?;
             }
         }
     }

@@ -54,6 +54,55 @@ fn invalid_config_names_the_field() {
     assert!(Planner::new(bad).is_err());
 }
 
+/// Without the `clarabel` feature the reference backend is a configuration error, not
+/// a compile error or a panic; with it, the same configuration builds a planner.
+#[test]
+fn clarabel_backend_needs_its_feature() {
+    let config = PlannerConfig {
+        backend: palc_planner::Backend::Clarabel,
+        ..PlannerConfig::default()
+    };
+    if cfg!(feature = "clarabel") {
+        assert!(Planner::new(config).is_ok());
+    } else {
+        let err = Planner::new(config).unwrap_err();
+        assert!(matches!(
+            err,
+            PlanError::Config(ConfigError::BackendUnavailable {
+                backend: "clarabel",
+                feature: "clarabel",
+            })
+        ));
+        assert!(err.to_string().contains("`clarabel` feature"));
+    }
+}
+
+/// The default backend's failures are typed, with a readable message.
+#[test]
+fn an_iteration_limit_is_a_typed_failure() {
+    let config = PlannerConfig {
+        horizon: 30,
+        solver: SolverSettings {
+            max_iter: 2,
+            ..SolverSettings::default()
+        },
+        ..PlannerConfig::default()
+    };
+    let problem = lane_change(&config, 20.0);
+    let err = Planner::new(config).unwrap().plan(&problem).unwrap_err();
+    assert_eq!(
+        err,
+        PlanError::SolverFailed {
+            status: palc_planner::SolverFailure::MaxIterations,
+            iterations: 2,
+        }
+    );
+    assert_eq!(
+        err.to_string(),
+        "qp solver failed with status max iterations after 2 iterations"
+    );
+}
+
 #[test]
 fn mismatched_dimensions_are_refused() {
     let c = config(30, LateralBoundsMode::Hard);

@@ -117,7 +117,7 @@ pub enum ConfigError {
         /// Number of cells.
         cells: usize,
     },
-    /// A test-bed operation on a config without a [testbed] table.
+    /// A test-bed operation on a config without a `[testbed]` table.
     #[error("the config has no [testbed] table")]
     NotATestbed,
 }

@@ -29,8 +29,9 @@
 //! assert!(prediction.adjacent[0][1] > 3.0); // the adjacent vehicle is on the target lane
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
+
+#![deny(missing_docs)]
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
-#![warn(missing_docs)]
 
 mod config;
 mod error;

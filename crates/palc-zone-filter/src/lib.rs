@@ -25,48 +25,14 @@
 //!
 //! # Example
 //!
-//! ```
-//! use palc_zone_filter::{
-//!     BoundsConfig, FeatureInput, FeatureSet, Label, Sample, StepBounds, StepScene,
-//!     ZoneConfig, ZoneModel, features, lateral_bounds,
-//! };
+//! From labelled samples in CSV to the lateral bounds of each planning step; this is
+//! `examples/fit_zone.rs` (`cargo run -p palc-zone-filter --example fit_zone`), run
+//! here as a doctest.
 //!
-//! // Preceding vehicle 30 m ahead in the ego lane, adjacent vehicle 10 m ahead in the target lane.
-//! let sample_at = |ego_l: f64, y| -> Result<Sample, palc_zone_filter::ZoneError> {
-//!     let input = FeatureInput {
-//!         ego_s: 0.0,
-//!         ego_l,
-//!         ego_speed: 20.0,
-//!         preceding: [30.0, 0.0],
-//!         adjacent: [10.0, 3.5],
-//!     };
-//!     Ok(Sample::new(features(FeatureSet::Paper, &input)?, y))
-//! };
-//! // The user took over when the system moved beyond about 1 m to the left.
-//! let mut samples = Vec::new();
-//! for k in 0..=10 {
-//!     let l = -0.5 + 0.1 * k as f64;
-//!     samples.push(sample_at(l, Label::Safe)?);
-//!     samples.push(sample_at(l + 1.6, Label::Unsafe)?);
-//! }
-//! let model = ZoneModel::fit(ZoneConfig::default(), &samples)?;
-//! assert!(model.is_informative());
-//!
-//! let step = StepScene {
-//!     ego_s: 0.0,
-//!     reference_l: 0.0,
-//!     ego_speed: 20.0,
-//!     preceding: [30.0, 0.0],
-//!     adjacent: [10.0, 3.5],
-//! };
-//! let bounds = lateral_bounds(&model, &[step], &BoundsConfig::default())?;
-//! let StepBounds::Bounded { min, max } = bounds[0] else {
-//!     panic!("expected a bounded step, got {:?}", bounds[0]);
-//! };
-//! assert!(min <= 0.0 && 0.0 <= max && max < 1.75);
-//! # Ok::<(), palc_zone_filter::ZoneError>(())
 //! ```
-#![warn(missing_docs)]
+#![doc = include_str!("../examples/fit_zone.rs")]
+//! ```
+#![deny(missing_docs)]
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 mod bounds;

@@ -3,10 +3,10 @@
 //!
 //! Input (JSON object; example: configs/examples/plan-problem.json):
 //! - `config`: the fields of `PlannerConfig`, each optional (defaults in brackets):
-//!   `horizon` K [60], `dt` s [0.1], `wheelbase` m [2.8], `acceleration_penalty` [1.0],
+//!   `horizon` K \[60\], `dt` s [0.1], `wheelbase` m [2.8], `acceleration_penalty` [1.0],
 //!   `steering_min`/`steering_max` rad [-0.5/0.5],
 //!   `lateral_bounds_mode`: `"hard"` or `{"soft": {"weight": w}}` [soft, 100],
-//!   `backend`: `"riccati"` [default] or `"clarabel"`, `solver`: `{max_iter, tol_gap_abs, tol_gap_rel, tol_feas,
+//!   `backend`: `"riccati"` \[default\] or `"clarabel"`, `solver`: `{max_iter, tol_gap_abs, tol_gap_rel, tol_feas,
 //!   equilibrate_enable, iterative_refinement_enable, reuse_structure}`.
 //! - `problem`: `initial` `{s, v, l, phi}` (X_0, s relative to the ego's start is
 //!   recommended); `reference_speed` (K numbers, m/s); `curvature` (1/m, optional);

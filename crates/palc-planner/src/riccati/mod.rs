@@ -18,7 +18,7 @@ mod stage_qp;
 
 use crate::backend::{RawSolution, RawStatus};
 use crate::qp::{Pattern, QpData};
-use crate::{PlanError, SolverSettings};
+use crate::{NumericalCause, PlanError, SolverSettings};
 
 use ipm::{Ipm, Outcome, Tolerances};
 use stage_qp::{NX, NZ, StageQp};
@@ -42,8 +42,8 @@ impl RiccatiBackend {
         let start = std::time::Instant::now();
         self.qp
             .load(data, horizon)
-            .map_err(|reason| PlanError::SolverFailed {
-                status: format!("riccati backend cannot read the QP: {reason}"),
+            .map_err(|layout| PlanError::SolverFailed {
+                status: NumericalCause::StageLayout(layout).into(),
                 iterations: 0,
             })?;
         let reused = self.pattern.as_ref() == Some(&pattern);

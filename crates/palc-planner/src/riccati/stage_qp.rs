@@ -10,6 +10,7 @@
 use nalgebra::{Matrix4, Matrix4x2, Matrix6, Vector4, Vector6};
 
 use super::sparse::StepDynamics;
+use crate::LayoutError;
 use crate::qp::QpData;
 
 /// Most inequality rows one slack may appear in (soft mode uses 3: above, below, `σ >= 0`).
@@ -87,14 +88,15 @@ enum Var {
 
 impl StageQp {
     /// Reads `data` (assembled for horizon `k`) into stage form, reusing the buffers.
-    /// Fails with a description when the data does not have the planner's layout.
-    pub fn load(&mut self, data: &QpData, k: usize) -> Result<(), String> {
+    /// Fails with the [`LayoutError`] where the data departs from the planner's layout.
+    pub fn load(&mut self, data: &QpData, k: usize) -> Result<(), LayoutError> {
         let n_core = NZ * k + NX;
         if data.n < n_core || data.m_eq < NX + NX * k || data.m_eq > 2 * NX + NX * k {
-            return Err(format!(
-                "unexpected QP size n = {}, m_eq = {} for K = {k}",
-                data.n, data.m_eq
-            ));
+            return Err(LayoutError::Size {
+                n: data.n,
+                m_eq: data.m_eq,
+                horizon: k,
+            });
         }
         let n_slack = data.n - n_core;
         let var = |col: usize| {
@@ -134,7 +136,7 @@ impl StageQp {
                         self.hessian[i][(b, a)] += v;
                     }
                 }
-                _ => return Err(format!("Hessian entry ({r}, {c}) couples two stages")),
+                _ => return Err(LayoutError::CoupledHessian { row: r, col: c }),
             }
         }
         for (col, &v) in data.q[..n_core].iter().enumerate() {
@@ -145,30 +147,30 @@ impl StageQp {
         for ((&r, &c), &v) in data.a_rows.iter().zip(&data.a_cols).zip(&data.a_vals) {
             let Var::Core(stage, local) = var(c) else {
                 if r < data.m_eq {
-                    return Err(format!("equality row {r} involves a slack"));
+                    return Err(LayoutError::SlackInEquality { row: r });
                 }
                 continue;
             };
             if r < NX {
                 if (stage, local) != (0, r) || v != 1.0 {
-                    return Err(format!("initial row {r} is not X_0[{r}] = x0"));
+                    return Err(LayoutError::InitialRow { row: r });
                 }
             } else if r < first_terminal {
                 let (step, comp) = ((r - NX) / NX, (r - NX) % NX);
                 if stage == step + 1 {
                     if local != comp || v != 1.0 {
-                        return Err(format!("dynamics row {r} is not X_(i+1)[{comp}] = ..."));
+                        return Err(LayoutError::DynamicsRow { row: r });
                     }
                 } else if stage == step && local < NX {
                     self.dense_dynamics[step].0[(comp, local)] -= v;
                 } else if stage == step {
                     self.dense_dynamics[step].1[(comp, local - NX)] -= v;
                 } else {
-                    return Err(format!("dynamics row {r} reaches stage {stage}"));
+                    return Err(LayoutError::DynamicsRow { row: r });
                 }
             } else if r < data.m_eq {
                 if stage != k || local >= NX {
-                    return Err(format!("terminal row {r} involves stage {stage}"));
+                    return Err(LayoutError::TerminalRow { row: r, stage });
                 }
                 self.terminal[(r - first_terminal, local)] += v;
             }
@@ -217,9 +219,7 @@ impl StageQp {
                     row.slack_coef = v;
                 }
                 _ => {
-                    return Err(format!(
-                        "inequality row {r} has more than one variable of a kind"
-                    ));
+                    return Err(LayoutError::InequalityRow { row: r - data.m_eq });
                 }
             }
         }
@@ -229,7 +229,7 @@ impl StageQp {
         for (row, ineq) in self.inequalities.iter().enumerate() {
             let Some(j) = ineq.slack else { continue };
             let Some(free) = self.slack_rows[j].iter_mut().find(|r| **r == usize::MAX) else {
-                return Err(format!("slack {j} is in more than {MAX_SLACK_ROWS} rows"));
+                return Err(LayoutError::Slack { slack: j });
             };
             *free = row;
             if let Some(core) = ineq.core {
@@ -237,15 +237,13 @@ impl StageQp {
                     None => self.slack_core[j] = Some(core),
                     Some(other) if other == core => {}
                     Some(_) => {
-                        return Err(format!(
-                            "slack {j} is tied to two stage variables (row {row})"
-                        ));
+                        return Err(LayoutError::Slack { slack: j });
                     }
                 }
             }
         }
         if let Some(j) = self.slack_rows.iter().position(|r| r[0] == usize::MAX) {
-            return Err(format!("slack {j} has no inequality row"));
+            return Err(LayoutError::Slack { slack: j });
         }
         self.softly_bounded.clear();
         self.softly_bounded.resize(NZ * (k + 1), false);
@@ -255,9 +253,7 @@ impl StageQp {
         for (row, ineq) in self.inequalities.iter().enumerate() {
             if let (Some((i, l)), None) = (ineq.core, ineq.slack) {
                 if self.softly_bounded[NZ * i + l] {
-                    return Err(format!(
-                        "row {row} bounds a softly bounded variable without its slack"
-                    ));
+                    return Err(LayoutError::HardRowOnSoftVariable { row });
                 }
             }
         }

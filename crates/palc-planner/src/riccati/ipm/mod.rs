@@ -26,6 +26,7 @@ mod newton;
 
 use super::recursion::{FactorError, Riccati};
 use super::stage_qp::StageQp;
+use crate::{NumericalCause, SolverFailure};
 use measures::{Measures, norm_inf};
 
 /// Relative tolerance of the infeasibility certificate: `‖Aᵀy + Gᵀλ‖∞ <= TOL · -(bᵀy + hᵀλ)`
@@ -67,7 +68,7 @@ pub(crate) enum Outcome {
     Solved,
     AlmostSolved,
     PrimalInfeasible,
-    Failed(String),
+    Failed(SolverFailure),
 }
 
 /// A copy of the primal-dual iterate.
@@ -255,7 +256,7 @@ impl Ipm {
     /// Runs the interior point from Mehrotra's start; the iterate holds the result.
     pub fn run(&mut self, qp: &StageQp, tol: &Tolerances) -> Outcome {
         if let Err(e) = self.start(qp) {
-            return Outcome::Failed(describe(e));
+            return Outcome::Failed(describe(e).into());
         }
         let mut stalled = 0;
         let mut since_best = 0;
@@ -285,11 +286,11 @@ impl Ipm {
                     .is_some_and(|b| b.meets(REDUCED_GAP, REDUCED_GAP, REDUCED_FEAS));
             if self.iterations >= tol.max_iter || stalled >= 3 || stagnant {
                 let reason = if stalled >= 3 || stagnant {
-                    "InsufficientProgress"
+                    SolverFailure::InsufficientProgress
                 } else {
-                    "MaxIterations"
+                    SolverFailure::MaxIterations
                 };
-                return self.stop(&measures, reason.into());
+                return self.stop(&measures, reason);
             }
             self.iterations += 1;
             // An exact Newton step scales the dual residual by (1 - α). Near the
@@ -306,7 +307,7 @@ impl Ipm {
                     stalled = if alpha < 1e-8 { stalled + 1 } else { 0 };
                     previous = Some((measures.res_dual, alpha));
                 }
-                Err(e) => return self.stop(&measures, describe(e)),
+                Err(e) => return self.stop(&measures, describe(e).into()),
             }
         }
     }
@@ -314,7 +315,7 @@ impl Ipm {
     /// The end without convergence: the best iterate if it meets clarabel's reduced
     /// tolerances (`AlmostSolved`), an infeasibility certificate at the reduced
     /// tolerance, or the failure `reason`.
-    fn stop(&mut self, current: &Measures, reason: String) -> Outcome {
+    fn stop(&mut self, current: &Measures, reason: SolverFailure) -> Outcome {
         if self
             .best
             .is_some_and(|b| b.meets(REDUCED_GAP, REDUCED_GAP, REDUCED_FEAS))
@@ -490,9 +491,9 @@ fn head(v: &mut Vector6<f64>, add: &Vector4<f64>) {
     h += add;
 }
 
-fn describe(e: FactorError) -> String {
+fn describe(e: FactorError) -> NumericalCause {
     match e {
-        FactorError::ControlBlock(i) => format!("control block of step {i} not positive definite"),
-        FactorError::Terminal => "terminal Schur complement not positive definite".into(),
+        FactorError::ControlBlock(step) => NumericalCause::ControlBlock { step },
+        FactorError::Terminal => NumericalCause::TerminalSchur,
     }
 }
