@@ -1,32 +1,39 @@
 //! One lane change: plan, execute in the scene, let the user judge each step.
 
 use palc_planner::{LateralBound, Plan, Position, Problem, State, Terminal, Weights};
-use palc_traffic::EgoState;
+use palc_traffic::{EgoState, ballistic_step};
 
 use crate::HarnessError;
+use crate::acc::acc_leader;
 use crate::record::Takeover;
+use crate::safety::{SafetyMetrics, SafetyMonitor};
 use crate::setup::Setup;
 use crate::user::{ExpectedLaneChange, first_takeover, max_deviation};
 
 /// The planning problem of this scenario with the given weights and lateral bounds.
+///
+/// The reference and terminal speeds are the ego ACC's while it keeps its lane
+/// ([`Setup::lane_keeping`]): the plan slows down behind a slower vehicle as the
+/// ego would.
 pub fn problem(setup: &Setup, weights: Weights, bounds: Vec<Option<LateralBound>>) -> Problem {
     let k = setup.horizon;
     let position = |p: &[f64; 2]| Position { s: p[0], l: p[1] };
+    let speed = |i: usize| setup.lane_keeping[i][1];
     Problem {
         initial: State {
             s: 0.0,
-            v: setup.ego_speed,
+            v: speed(0),
             l: 0.0,
             phi: 0.0,
         },
-        reference_speed: vec![setup.ego_speed; k],
+        reference_speed: (0..k).map(speed).collect(),
         curvature: 0.0,
         weights,
         preceding: setup.preceding[..k].iter().map(position).collect(),
         adjacent: setup.adjacent[..k].iter().map(position).collect(),
         terminal: Terminal {
-            s: None,
-            v: setup.ego_speed,
+            s: Some(setup.lane_keeping[k][0]),
+            v: speed(k),
             l: setup.target_l,
         },
         lateral_bounds: if bounds.is_empty() {
@@ -59,10 +66,16 @@ pub struct Drive {
     pub max_deviation_m: f64,
     /// Perceived safety distance ratio (1 without takeover).
     pub perceived_safety_ratio: f64,
+    /// Safety of the steps the system drove (the plan, up to a takeover).
+    pub safety: SafetyMetrics,
+    /// Safety of the steps the user drove after a takeover (default without one).
+    pub user_safety: SafetyMetrics,
 }
 
 /// Drives `plan` in a clone of the scene; the user of `expected` takes over at the
-/// first step deviating more than `threshold` and then drives the expected path.
+/// first step deviating more than `threshold` and then drives the expected lateral
+/// path, its speed set by the ego's ACC behind whatever is ahead in the lanes it
+/// occupies.
 pub fn execute(
     setup: &Setup,
     plan: Plan,
@@ -75,48 +88,54 @@ pub fn execute(
     let expected_l = expected.sample(k, dt);
     let takeover_step = first_takeover(&planned_l, &expected_l, threshold);
 
-    let driven: Vec<State> = match takeover_step {
-        None => plan.states.clone(),
-        Some(step) => {
-            let mut driven = plan.states[..step].to_vec();
-            let mut s = driven.last().map_or(0.0, |x| x.s);
-            for i in step..=k {
-                if i > 0 {
-                    s += setup.ego_speed * dt;
-                }
-                let next_l = expected_l[(i + 1).min(k)];
-                let phi = (next_l - expected_l[i]) / (setup.ego_speed * dt);
-                driven.push(State {
-                    s,
-                    v: setup.ego_speed,
-                    l: expected_l[i],
-                    phi: if i == k { 0.0 } else { phi },
-                });
-            }
-            driven
-        }
-    };
-
     let mut scene = setup.scene.clone();
+    let mut system = SafetyMonitor::new(setup.safety, &scene, setup.target_l);
+    let mut user = system.clone();
+    let mut driven: Vec<State> = Vec::with_capacity(k + 1);
     let mut preceding = Vec::with_capacity(k + 1);
     let mut adjacent = Vec::with_capacity(k + 1);
     let frame = |p: Option<&palc_traffic::Vehicle>| {
         p.map_or([1e4, 0.0], |v| [v.state.s - setup.origin_s, v.state.l])
     };
     for i in 0..=k {
+        let by_user = takeover_step.is_some_and(|step| i >= step);
+        let state = match (by_user, driven.last()) {
+            (false, _) => plan.states[i],
+            (true, None) => State {
+                l: expected_l[0],
+                ..plan.states[0]
+            },
+            (true, Some(previous)) => {
+                let acceleration =
+                    setup
+                        .acc
+                        .acceleration(previous.v, setup.set_speed, acc_leader(&scene));
+                let moved = ballistic_step(previous.v, acceleration, dt);
+                State {
+                    s: previous.s + moved.distance,
+                    v: moved.speed,
+                    l: expected_l[i],
+                    phi: 0.0,
+                }
+            }
+        };
+        if i > 0 {
+            scene.step(dt, ego_state(setup, &state))?;
+        }
+        if by_user {
+            user.observe(i, &scene);
+        } else {
+            system.observe(i, &scene);
+        }
         preceding.push(frame(scene.preceding()));
         adjacent.push(frame(scene.adjacent()));
-        if i < k {
-            let x = driven[i + 1];
-            scene.step(
-                dt,
-                EgoState {
-                    s: x.s + setup.origin_s,
-                    l: x.l,
-                    v: x.v.max(0.0),
-                    heading: x.phi,
-                },
-            )?;
+        driven.push(state);
+    }
+    // The user's heading follows its lateral path.
+    if let Some(step) = takeover_step {
+        for i in step..k {
+            let run = (driven[i].v * dt).max(1e-9);
+            driven[i].phi = (expected_l[i + 1] - expected_l[i]) / run;
         }
     }
 
@@ -153,7 +172,32 @@ pub fn execute(
         preceding,
         adjacent,
         perceived_safety_ratio,
+        safety: system.metrics(),
+        user_safety: user.metrics(),
     })
+}
+
+/// The safety of `plan` driven to its end in a clone of the scene, with the other
+/// vehicles reacting as the simulation moves them: the prediction that the safety
+/// layer checks before the ego drives a plan.
+pub fn plan_safety(setup: &Setup, plan: &Plan) -> Result<SafetyMetrics, HarnessError> {
+    let mut scene = setup.scene.clone();
+    let mut monitor = SafetyMonitor::new(setup.safety, &scene, setup.target_l);
+    monitor.observe(0, &scene);
+    for (i, state) in plan.states.iter().enumerate().skip(1) {
+        scene.step(setup.dt, ego_state(setup, state))?;
+        monitor.observe(i, &scene);
+    }
+    Ok(monitor.metrics())
+}
+
+fn ego_state(setup: &Setup, state: &State) -> EgoState {
+    EgoState {
+        s: state.s + setup.origin_s,
+        l: state.l,
+        v: state.v.max(0.0),
+        heading: state.phi,
+    }
 }
 
 /// The first step from which the driven lateral position stays within 5 cm of the

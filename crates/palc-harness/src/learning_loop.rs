@@ -14,12 +14,13 @@ use palc_planner::{LateralBoundsMode, Plan, Planner, PlannerConfig, Problem};
 
 use crate::HarnessError;
 use crate::config::{LearnConfig, StoppingConfig};
-use crate::drive::{Drive, execute, problem};
+use crate::drive::{Drive, execute, plan_safety, problem};
 use crate::learn::{RunResult, aggregator_options, prepare};
 use crate::lesson::{lesson, scenes, zone_feature_set};
 use crate::method::Method;
 use crate::observer::{LessonEvent, Observer};
 use crate::record::{LaneChangeRecord, Outcome, RunSummary};
+use crate::safety::{SafetyMetrics, Violation};
 use crate::setup::Setup;
 use crate::user::{User, first_takeover};
 
@@ -55,6 +56,9 @@ pub struct LearningLoop {
     template: Problem,
     experience: Experience,
     next_plan: Plan,
+    /// The standard ALC's plan, checked safe: what the safety layer drives when it
+    /// refuses `next_plan`.
+    fallback_plan: Plan,
     /// Compute time of the step that produced `next_plan`.
     pending_times: Timings,
     records: Vec<LaneChangeRecord>,
@@ -104,6 +108,20 @@ impl LearningLoop {
                 reason: "the user does not change lanes within the horizon".to_owned(),
             })?
             .sample(setup.horizon, setup.dt);
+        let standard = setup.standard_lane_change(&config.planning.standard_alc);
+        let standard_weights = config
+            .standard_weights
+            .weights(&standard, setup.horizon, setup.dt);
+        let fallback_plan = planner.plan(&problem(&setup, standard_weights, Vec::new()))?;
+        let fallback_safety = plan_safety(&setup, &fallback_plan)?;
+        if let Some(violation) = unsafe_because(&fallback_safety) {
+            return Err(HarnessError::Scenario {
+                scenario: config.label(),
+                reason: format!(
+                    "no safe lane change: the standard ALC's plan is refused ({violation})"
+                ),
+            });
+        }
         let template = problem(&setup, experience.weights.clone(), Vec::new());
         let (first_problem, _) = plan_problem(
             &planner,
@@ -131,6 +149,7 @@ impl LearningLoop {
             template,
             experience,
             next_plan,
+            fallback_plan,
             pending_times,
             records: Vec::new(),
             takeovers: 0,
@@ -153,9 +172,15 @@ impl LearningLoop {
     /// A drawn user who does not change lanes within the horizon, or a plan, drive
     /// or feature error.
     pub fn step(&mut self, observer: &mut dyn Observer) -> Result<&LaneChangeRecord, HarnessError> {
-        let drive = self.drive()?;
-        let record = self.record(&drive);
-        let index = record.index;
+        let index = self.records.len();
+        let (plan, planned_safety, refusal) = self.checked_plan()?;
+        if let Some(violation) = &refusal {
+            observer.safety_refusal(index, violation);
+        }
+        let drive = self.drive(plan)?;
+        let mut record = self.record(&drive);
+        record.planned_safety = planned_safety;
+        record.safety_refusal = refusal;
         observer.lane_change(&record);
         self.records.push(record);
         self.pending_times = Timings::default();
@@ -235,8 +260,22 @@ impl LearningLoop {
         &self.next_plan
     }
 
-    /// Draws the user of the next lane change and drives the current plan in the scene.
-    fn drive(&mut self) -> Result<Drive, HarnessError> {
+    /// The safety layer: the learned plan if it is safe, else the standard ALC's
+    /// (checked safe when the loop was prepared), with the predicted safety of the
+    /// plan returned and the reason for a refusal.
+    fn checked_plan(&self) -> Result<(Plan, SafetyMetrics, Option<Violation>), HarnessError> {
+        let predicted = plan_safety(&self.setup, &self.next_plan)?;
+        match unsafe_because(&predicted) {
+            None => Ok((self.next_plan.clone(), predicted, None)),
+            Some(violation) => {
+                let fallback = plan_safety(&self.setup, &self.fallback_plan)?;
+                Ok((self.fallback_plan.clone(), fallback, Some(violation)))
+            }
+        }
+    }
+
+    /// Draws the user of the next lane change and drives `plan` in the scene.
+    fn drive(&mut self, plan: Plan) -> Result<Drive, HarnessError> {
         let style = self.user.next_style();
         let expected = self
             .setup
@@ -248,12 +287,7 @@ impl LearningLoop {
                     style.time_headway_s, style.lane_change_duration_s
                 ),
             })?;
-        execute(
-            &self.setup,
-            self.next_plan.clone(),
-            expected,
-            self.takeover_threshold_m,
-        )
+        execute(&self.setup, plan, expected, self.takeover_threshold_m)
     }
 
     /// The record of a driven lane change.
@@ -276,6 +310,10 @@ impl LearningLoop {
                 self.takeover_threshold_m,
             )
             .is_some(),
+            safety: drive.safety,
+            user_safety: drive.user_safety,
+            planned_safety: SafetyMetrics::default(),
+            safety_refusal: None,
             learning_error: None,
         }
     }
@@ -343,6 +381,15 @@ impl LearningLoop {
             final_takeover_rate: rate(|r| r.takeover.is_some()),
             ceiling_takeover_rate: rate(|r| r.nominal_plan_taken_over),
         }
+    }
+}
+
+/// Why predicted `safety` is not safe: its first violation, or `None` when it is safe.
+fn unsafe_because(safety: &SafetyMetrics) -> Option<Violation> {
+    if safety.is_safe() {
+        None
+    } else {
+        safety.first_violation
     }
 }
 
@@ -467,6 +514,10 @@ mod tests {
             driven_l: Vec::new(),
             with_spread,
             nominal_plan_taken_over: nominal_taken,
+            safety: SafetyMetrics::default(),
+            user_safety: SafetyMetrics::default(),
+            planned_safety: SafetyMetrics::default(),
+            safety_refusal: None,
             learning_error: None,
         }
     }

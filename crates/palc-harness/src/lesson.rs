@@ -41,7 +41,8 @@ pub(crate) fn lesson(
             &FeatureInput {
                 ego_s: state.s,
                 ego_l: state.l,
-                ego_speed: setup.ego_speed,
+                // The speed the state was driven at (the ego's ACC changes it).
+                ego_speed: state.v.max(setup.ego_speed * 1e-3),
                 preceding: drive.preceding[i],
                 adjacent: drive.adjacent[i],
             },
@@ -72,19 +73,21 @@ pub(crate) fn lesson(
     })
 }
 
-/// The zone filter's view of each planning step: the previous plan's position
-/// (or lane keeping before any plan) and the predicted vehicles.
+/// The zone filter's view of each planning step: the previous plan's position and
+/// speed (or the ego keeping its lane under its ACC before any plan) and the
+/// predicted vehicles.
 pub(crate) fn scenes(setup: &Setup, previous: Option<&[State]>) -> Vec<StepScene> {
     (0..=setup.horizon)
         .map(|i| {
-            let (ego_s, reference_l) = previous
-                .map_or((setup.ego_speed * i as f64 * setup.dt, 0.0), |states| {
-                    (states[i].s, states[i].l)
+            let [keeping_s, keeping_v] = setup.lane_keeping[i];
+            let (ego_s, reference_l, ego_speed) = previous
+                .map_or((keeping_s, 0.0, keeping_v), |states| {
+                    (states[i].s, states[i].l, states[i].v.max(keeping_v * 1e-3))
                 });
             StepScene {
                 ego_s,
                 reference_l,
-                ego_speed: setup.ego_speed,
+                ego_speed,
                 preceding: setup.preceding[i],
                 adjacent: setup.adjacent[i],
             }

@@ -30,6 +30,7 @@
 #![warn(clippy::print_stdout, clippy::print_stderr)]
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
+mod acc;
 mod config;
 mod drive;
 mod error;
@@ -39,15 +40,17 @@ mod lesson;
 mod method;
 mod observer;
 mod record;
+pub mod safety;
 mod setup;
 mod standard_alc;
 pub mod user;
 
+pub use acc::{AccConfig, acc_leader};
 pub use config::{
     CellChoice, LearnConfig, MAX_LANE_CHANGES, MAX_SUCCESS_STREAK, MAX_TAKEOVERS, StoppingConfig,
     UserConfig, UserStyle,
 };
-pub use drive::{Drive, execute, problem};
+pub use drive::{Drive, execute, plan_safety, problem};
 pub use error::HarnessError;
 pub use learn::{RunResult, aggregator_options, prepare, run};
 pub use learning_loop::LearningLoop;
@@ -55,6 +58,7 @@ pub use method::{Driver, Method, label};
 pub use observer::{LessonEvent, NoObserver, Observer};
 pub use palc_aggregator::Timings;
 pub use record::{LaneChangeRecord, Outcome, RunSummary, Takeover};
+pub use safety::{SafetyConfig, SafetyMetrics, SafetyMonitor, Violation};
 pub use setup::{PlanningConfig, Setup};
 pub use standard_alc::StandardWeights;
 pub use user::StylePreset;

@@ -5,6 +5,7 @@
 use palc_aggregator::{AggregatorError, Lesson, StepOutcome};
 
 use crate::record::{LaneChangeRecord, RunSummary};
+use crate::safety::Violation;
 
 /// What one lesson produced (paper Fig. 2, the learning branch after a takeover).
 #[derive(Debug, Clone, Copy)]
@@ -57,6 +58,10 @@ impl LessonEvent<'_> {
 /// [`Observer::lesson`] once, learned or failed. [`Observer::finished`] comes once,
 /// after the last lane change.
 pub trait Observer {
+    /// Called before lane change `lane_change` when the safety layer refuses the
+    /// learned plan (the standard ALC's plan is driven instead); the record of the
+    /// lane change keeps the violation too.
+    fn safety_refusal(&mut self, _lane_change: usize, _violation: &Violation) {}
     /// Called after each lane change, before its lesson (if any) is learned.
     fn lane_change(&mut self, _record: &LaneChangeRecord) {}
     /// Called after each lesson, whether the method learned from it or not.

@@ -3,6 +3,8 @@
 use palc_aggregator::Timings;
 use serde::{Deserialize, Serialize};
 
+use crate::safety::{SafetyMetrics, Violation};
+
 /// Where and how the user took over.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Takeover {
@@ -47,6 +49,16 @@ pub struct LaneChangeRecord {
     /// Whether the user's *nominal* trajectory, used as the plan, would have been
     /// taken over against this lane change's draw (the ceiling of a user with spread).
     pub nominal_plan_taken_over: bool,
+    /// Safety of the steps the system drove (the plan, up to a takeover).
+    pub safety: SafetyMetrics,
+    /// Safety of the steps the user drove after a takeover (all `None` and zero
+    /// without one): the simulated user's own choices, which no plan controls.
+    pub user_safety: SafetyMetrics,
+    /// Safety of the driven plan as the safety layer predicted it, driven to its end.
+    pub planned_safety: SafetyMetrics,
+    /// Why the safety layer refused the learned plan, if it did; the standard ALC's
+    /// plan was driven instead.
+    pub safety_refusal: Option<Violation>,
     /// Why the learning step after this lane change failed, if it did, as a
     /// message for `--record` files; the experience then stays as it was.
     /// Observers see the typed error in [`crate::LessonEvent::Failed`].

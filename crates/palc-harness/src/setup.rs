@@ -9,10 +9,12 @@
 //! a margin, so that no user's lane change ends after the terminal condition pins
 //! the lateral position.
 
-use palc_traffic::{EgoState, Lane, Scene};
+use palc_traffic::{EgoState, Lane, Scene, ballistic_step};
 use serde::{Deserialize, Serialize};
 
 use crate::HarnessError;
+use crate::acc::{AccConfig, acc_leader};
+use crate::safety::SafetyConfig;
 use crate::user::{ExpectedLaneChange, Situation, Style, StylePreset};
 
 /// Parameters of the planning set-up; defaults in `configs/learn.toml`.
@@ -35,11 +37,19 @@ pub struct PlanningConfig {
     /// The standard ALC starts no earlier than this long after the latest of the
     /// paper's three styles (s): a conservative system waits until every style would
     /// have gone, also when a user's start is set by a gap on the target lane.
+    /// Being the system, it also waits until both target-lane gaps stay at least the
+    /// safe distance of `safety` over its whole lane change, as predicted with the
+    /// ego keeping its lane.
     pub standard_alc_min_delay_s: f64,
     /// Lateral position of the target lane's centre (m).
     pub target_l: f64,
     /// Deviation beyond which the user takes over (m); the paper's 0.3 m.
     pub takeover_threshold_m: f64,
+    /// The ego's ACC whenever no lane-change plan drives it (the approach, the
+    /// lane-keeping prediction, the user after a takeover).
+    pub acc: AccConfig,
+    /// The safe distance of the safety layer and of the safety measures.
+    pub safety: SafetyConfig,
 }
 
 impl Default for PlanningConfig {
@@ -58,6 +68,8 @@ impl Default for PlanningConfig {
             standard_alc_min_delay_s: 0.5,
             target_l: 3.5,
             takeover_threshold_m: 0.3,
+            acc: AccConfig::default(),
+            safety: SafetyConfig::default(),
         }
     }
 }
@@ -100,7 +112,9 @@ impl PlanningConfig {
         if !self.target_l.is_finite() {
             return Err(invalid("planning.target_l", self.target_l, "finite"));
         }
-        self.standard_alc.validate("planning.standard_alc")
+        self.standard_alc.validate("planning.standard_alc")?;
+        self.acc.validate("planning.acc")?;
+        self.safety.validate("planning.safety")
     }
 }
 
@@ -123,8 +137,17 @@ pub struct Setup {
     pub horizon: usize,
     /// Step (s).
     pub dt: f64,
-    /// Ego speed, held through the lane change (m/s).
+    /// Ego speed at the trigger (m/s).
     pub ego_speed: f64,
+    /// The ego's set speed: its speed at the start of the scene (m/s).
+    pub set_speed: f64,
+    /// The ego's ACC.
+    pub acc: AccConfig,
+    /// The safe distance of the safety layer.
+    pub safety: SafetyConfig,
+    /// The ego keeping its lane under its ACC: `(s − origin_s, v)` at steps `0..`
+    /// of the search window. Plans take their reference speeds from it.
+    pub lane_keeping: Vec<[f64; 2]>,
     /// Ego longitudinal position at the trigger (m); plans use `s` relative to it.
     pub origin_s: f64,
     /// What a user sees at each step `0..` of the search window, the ego keeping its lane.
@@ -140,8 +163,8 @@ pub struct Setup {
 }
 
 impl Setup {
-    /// Drives the ego at constant speed in its lane until the trigger, then predicts
-    /// the scene over the search window.
+    /// Drives the ego in its lane under its ACC until the trigger, then predicts
+    /// the scene over the search window, the ego still keeping its lane under its ACC.
     pub fn new(scene: &Scene, config: &PlanningConfig, label: &str) -> Result<Setup, HarnessError> {
         config.validate()?;
         let scenario_error = |reason: String| HarnessError::Scenario {
@@ -151,10 +174,10 @@ impl Setup {
         let ego = scene
             .ego()
             .ok_or_else(|| scenario_error("the scene has no ego vehicle".to_owned()))?;
-        let ego_speed = ego.state.v;
-        if ego_speed.is_nan() || ego_speed <= 0.0 {
+        let set_speed = ego.state.v;
+        if set_speed.is_nan() || set_speed <= 0.0 {
             return Err(scenario_error(format!(
-                "the ego speed is {ego_speed} m/s, expected > 0"
+                "the ego speed is {set_speed} m/s, expected > 0"
             )));
         }
         if scene.preceding().is_none() {
@@ -171,7 +194,7 @@ impl Setup {
                 trigger = Some(step);
                 break;
             }
-            lane_keeping_step(&mut scene, config.dt)?;
+            lane_keeping_step(&mut scene, config, set_speed)?;
         }
         if trigger.is_none() {
             return Err(scenario_error(format!(
@@ -181,14 +204,26 @@ impl Setup {
         }
         let trigger_time_s = scene.time();
         let origin_s = scene.ego().map_or(0.0, |e| e.state.s);
+        let ego_speed = scene.ego().map_or(set_speed, |e| e.state.v);
+        if ego_speed <= 0.0 {
+            return Err(scenario_error(format!(
+                "the ego has stopped behind the preceding vehicle before the trigger (speed {ego_speed:?} m/s)"
+            )));
+        }
 
         let window = (config.search_window_s / config.dt).ceil() as usize;
         let mut rollout = scene.clone();
         let mut situations = Vec::with_capacity(window + 1);
         let mut preceding = Vec::with_capacity(window + 1);
         let mut adjacent = Vec::with_capacity(window + 1);
+        let mut lane_keeping = Vec::with_capacity(window + 1);
         for step in 0..=window {
             situations.push(situation(&rollout));
+            lane_keeping.push(
+                rollout
+                    .ego()
+                    .map_or([0.0, ego_speed], |e| [e.state.s - origin_s, e.state.v]),
+            );
             preceding.push(relative(
                 rollout.preceding().map(|v| (v.state.s, v.state.l)),
                 origin_s,
@@ -198,7 +233,7 @@ impl Setup {
                 origin_s,
             ));
             if step < window {
-                lane_keeping_step(&mut rollout, config.dt)?;
+                lane_keeping_step(&mut rollout, config, set_speed)?;
             }
         }
 
@@ -220,7 +255,21 @@ impl Setup {
             latest_user = latest_user.max(start);
         }
         let delay = (config.standard_alc_min_delay_s / config.dt).ceil() as usize;
-        let standard_start_step = own_start.max(latest_user + delay);
+        let duration = (standard.lane_change_duration_s / config.dt).ceil() as usize;
+        let earliest = own_start.max(latest_user + delay);
+        let standard_start_step = (earliest..=window.saturating_sub(duration))
+            .find(|&start| {
+                situations[start..=start + duration]
+                    .iter()
+                    .all(|s| target_gaps_safe(s, &config.safety))
+            })
+            .ok_or_else(|| {
+                scenario_error(format!(
+                    "no safe lane change: the target-lane gaps stay below the safe distance \
+                     for the standard ALC's {} s lane change within the {} s search window",
+                    standard.lane_change_duration_s, config.search_window_s
+                ))
+            })?;
         let end_s = standard_start_step as f64 * config.dt
             + standard.lane_change_duration_s
             + config.horizon_margin_s;
@@ -238,6 +287,10 @@ impl Setup {
             horizon,
             dt: config.dt,
             ego_speed,
+            set_speed,
+            acc: config.acc,
+            safety: config.safety,
+            lane_keeping,
             origin_s,
             situations,
             preceding,
@@ -302,16 +355,37 @@ impl Setup {
     }
 }
 
-/// One simulation step with the ego at constant speed in its lane.
-fn lane_keeping_step(scene: &mut Scene, dt: f64) -> Result<(), HarnessError> {
+/// Whether both target-lane gaps in `situation` are at least the safe distance:
+/// the ego behind the lead, the lag behind the ego.
+fn target_gaps_safe(situation: &Situation, safety: &SafetyConfig) -> bool {
+    let v = situation.ego_speed;
+    let lead_ok = match (situation.target_lead_gap_m, situation.target_lead_speed) {
+        (Some(gap), Some(lead_v)) => gap >= safety.safe_distance(v, lead_v),
+        _ => true,
+    };
+    let lag_ok = match (situation.target_lag_gap_m, situation.target_lag_speed) {
+        (Some(gap), Some(lag_v)) => gap >= safety.safe_distance(lag_v, v),
+        _ => true,
+    };
+    lead_ok && lag_ok
+}
+
+/// One simulation step with the ego keeping its lane under its ACC.
+fn lane_keeping_step(
+    scene: &mut Scene,
+    config: &PlanningConfig,
+    set_speed: f64,
+) -> Result<(), HarnessError> {
     let ego = scene.ego().map(|e| e.state).unwrap_or_default();
+    let acceleration = config.acc.acceleration(ego.v, set_speed, acc_leader(scene));
+    let moved = ballistic_step(ego.v, acceleration, config.dt);
     let next = EgoState {
-        s: ego.s + ego.v * dt,
+        s: ego.s + moved.distance,
         l: ego.l,
-        v: ego.v,
+        v: moved.speed,
         heading: 0.0,
     };
-    scene.step(dt, next)?;
+    scene.step(config.dt, next)?;
     Ok(())
 }
 
@@ -325,20 +399,20 @@ fn situation(scene: &Scene) -> Situation {
         .map_or(f64::INFINITY, |p| p.rear() - ego.s);
     let ego_rear = scene.ego().map_or(ego.s, |e| e.rear());
     let target_lane = scene.vehicles().iter().filter(|v| v.lane == Lane(1));
-    let target_lead_gap_m = target_lane
+    let lead = target_lane
         .clone()
         .filter(|v| v.state.s > ego.s)
-        .map(|v| v.rear() - ego.s)
-        .min_by(f64::total_cmp);
-    let target_lag_gap_m = target_lane
+        .min_by(|a, b| a.state.s.total_cmp(&b.state.s));
+    let lag = target_lane
         .filter(|v| v.state.s <= ego.s)
-        .map(|v| ego_rear - v.state.s)
-        .min_by(f64::total_cmp);
+        .max_by(|a, b| a.state.s.total_cmp(&b.state.s));
     Situation {
         time_headway_s: headway_gap / ego_speed,
-        target_lead_gap_m,
-        target_lag_gap_m,
+        target_lead_gap_m: lead.map(|v| v.rear() - ego.s),
+        target_lag_gap_m: lag.map(|v| ego_rear - v.state.s),
         ego_speed,
+        target_lead_speed: lead.map(|v| v.state.v),
+        target_lag_speed: lag.map(|v| v.state.v),
     }
 }
 

@@ -7,7 +7,8 @@
 //! model"): the user starts the lane change at the first step where the time
 //! headway to the preceding vehicle has fallen to the user's value *and* the gap
 //! on the target lane is acceptable to the user, then moves laterally along a
-//! quintic (minimum-jerk) profile over the user's duration, at constant speed.
+//! quintic (minimum-jerk) profile over the user's duration; its speed is the
+//! ego ACC's (docs/paper-mapping.md, "Ego longitudinal behaviour").
 
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -24,8 +25,10 @@ pub struct Style {
     /// Duration of the lateral move from lane centre to lane centre (s).
     pub lane_change_duration_s: f64,
     /// Smallest net gap to the leader on the target lane that the user accepts,
-    /// as a time gap at the ego's speed (s). Not in the paper: it makes the
-    /// paper's congestion levels matter (see docs/paper-mapping.md).
+    /// as a time gap at the ego's speed (s); the gap to the follower on the target
+    /// lane must be as long, as a time gap at the follower's speed. Not in the
+    /// paper: it makes the paper's congestion levels matter (see
+    /// docs/paper-mapping.md).
     #[serde(default = "Style::default_min_lead_gap_s")]
     pub min_lead_gap_s: f64,
 }
@@ -165,6 +168,10 @@ pub struct Situation {
     pub target_lag_gap_m: Option<f64>,
     /// Ego speed (m/s).
     pub ego_speed: f64,
+    /// Speed of the leader on the target lane (m/s); `None` when there is none.
+    pub target_lead_speed: Option<f64>,
+    /// Speed of the follower on the target lane (m/s); `None` when there is none.
+    pub target_lag_speed: Option<f64>,
 }
 
 impl Style {
@@ -173,9 +180,15 @@ impl Style {
         let lead_ok = situation
             .target_lead_gap_m
             .is_none_or(|gap| gap >= self.min_lead_gap_s * situation.ego_speed);
-        // Nobody starts a lane change into a vehicle alongside.
-        let lag_ok = situation.target_lag_gap_m.is_none_or(|gap| gap > 0.0);
-        situation.time_headway_s <= self.time_headway_s && lead_ok && lag_ok
+        // Nobody starts a lane change into a vehicle alongside, nor just ahead of
+        // one: the gap behind must be as long, in time at the follower's speed, as
+        // the gap ahead the user accepts.
+        let lag_ok = situation.target_lag_gap_m.is_none_or(|gap| {
+            gap > 0.0 && gap >= self.min_lead_gap_s * situation.target_lag_speed.unwrap_or(0.0)
+        });
+        // Nor behind a preceding vehicle it has already reached.
+        let behind = situation.time_headway_s > 0.0;
+        behind && situation.time_headway_s <= self.time_headway_s && lead_ok && lag_ok
     }
 
     /// The first step at which the user starts, given the situation per step.
@@ -350,6 +363,8 @@ mod tests {
             target_lead_gap_m: gap,
             target_lag_gap_m: Some(3.0),
             ego_speed: 20.0,
+            target_lead_speed: Some(20.0),
+            target_lag_speed: Some(20.0),
         };
         let situations = [
             at(2.0, Some(50.0)),

@@ -1,0 +1,215 @@
+//! The ego's longitudinal behaviour while it keeps or changes lanes: an adaptive
+//! cruise control (ACC) with a constant time gap, and an emergency brake.
+//!
+//! The paper holds every speed constant per speed case. palc does not: an ego that
+//! keeps its speed while a user waits for a gap on the target lane drives through
+//! the slower vehicle ahead (docs/paper-mapping.md, "Ego longitudinal behaviour").
+//! Whenever the system is not executing a lane-change plan (the approach, the
+//! lane-keeping prediction that users' start rules see, the user's own driving after
+//! a takeover) the ego follows the nearest vehicle ahead in the lanes its body
+//! occupies with the constant-time-gap law of Rajamani (*Vehicle Dynamics and
+//! Control*, 2nd ed., Sec. 6.5):
+//!
+//! ```text
+//! a = clamp( k_s (g − s_0 − T v) + k_v (v_l − v),  −b,  a_max )   and  a ≤ k_c (v_set − v)
+//! ```
+//!
+//! with `g` the net gap, `v_l` the leader's speed and `v_set` the ego's speed at the
+//! start of the scene (its set speed). The gains give a closed loop
+//! `λ² + (k_v + k_s T) λ + k_s = 0` with damping 0.93 at the defaults, so the gap
+//! settles without overshoot. When closing so fast that the comfortable
+//! deceleration `b` cannot match speeds before the standstill gap, the ego brakes
+//! with the kinematic deceleration `(v − v_l)² / (2 (g − s_0))`, up to the
+//! emergency limit (an automatic emergency brake).
+
+use palc_traffic::{Driver, Scene};
+use serde::{Deserialize, Serialize};
+
+use crate::HarnessError;
+
+/// Parameters of the ego's ACC; defaults in `configs/learn.toml` (`[planning.acc]`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct AccConfig {
+    /// Time gap `T` kept to the vehicle ahead (s). 0.8 s is the shortest that
+    /// ISO 15622 lets an ACC offer; it must be shorter than every user's start
+    /// headway (the paper's shortest is 1.15 s), or the users waiting behind the
+    /// slower vehicle would never reach it.
+    pub time_gap_s: f64,
+    /// Net gap `s_0` kept at standstill (m).
+    pub standstill_gap_m: f64,
+    /// Gap gain `k_s` (1/s²).
+    pub gap_gain: f64,
+    /// Speed-difference gain `k_v` (1/s).
+    pub speed_gain: f64,
+    /// Gain `k_c` towards the set speed on a free road (1/s).
+    pub cruise_gain: f64,
+    /// Largest acceleration `a_max` (m/s²).
+    pub max_acceleration_mps2: f64,
+    /// Comfortable deceleration `b` (m/s²), the limit of the time-gap law.
+    pub comfort_deceleration_mps2: f64,
+    /// Emergency deceleration (m/s²), used only when `b` cannot avoid the vehicle ahead.
+    pub emergency_deceleration_mps2: f64,
+}
+
+impl Default for AccConfig {
+    fn default() -> Self {
+        Self {
+            time_gap_s: 0.8,
+            standstill_gap_m: 2.0,
+            gap_gain: 0.15,
+            speed_gain: 0.6,
+            cruise_gain: 0.5,
+            max_acceleration_mps2: 1.5,
+            comfort_deceleration_mps2: 3.0,
+            emergency_deceleration_mps2: 8.0,
+        }
+    }
+}
+
+/// Largest deceleration any config may ask for (m/s²): about the friction limit
+/// of a passenger car on dry asphalt.
+pub const MAX_DECELERATION_MPS2: f64 = 10.0;
+
+impl AccConfig {
+    /// Checks every field against its bound.
+    pub fn validate(&self, table: &str) -> Result<(), HarnessError> {
+        let positive = [
+            ("time_gap_s", self.time_gap_s, 10.0),
+            ("gap_gain", self.gap_gain, 10.0),
+            ("speed_gain", self.speed_gain, 10.0),
+            ("cruise_gain", self.cruise_gain, 10.0),
+            ("max_acceleration_mps2", self.max_acceleration_mps2, 10.0),
+            (
+                "comfort_deceleration_mps2",
+                self.comfort_deceleration_mps2,
+                MAX_DECELERATION_MPS2,
+            ),
+            (
+                "emergency_deceleration_mps2",
+                self.emergency_deceleration_mps2,
+                MAX_DECELERATION_MPS2,
+            ),
+        ];
+        for (name, value, max) in positive {
+            if !(value.is_finite() && value > 0.0 && value <= max) {
+                return Err(HarnessError::InvalidConfig {
+                    field: format!("{table}.{name}"),
+                    value,
+                    bound: format!("a value in (0, {max:?}]"),
+                });
+            }
+        }
+        if !(self.standstill_gap_m.is_finite() && (0.0..=50.0).contains(&self.standstill_gap_m)) {
+            return Err(HarnessError::InvalidConfig {
+                field: format!("{table}.standstill_gap_m"),
+                value: self.standstill_gap_m,
+                bound: "a value in [0, 50.0]".to_owned(),
+            });
+        }
+        if self.emergency_deceleration_mps2 < self.comfort_deceleration_mps2 {
+            return Err(HarnessError::InvalidConfig {
+                field: format!("{table}.emergency_deceleration_mps2"),
+                value: self.emergency_deceleration_mps2,
+                bound: format!(
+                    "at least comfort_deceleration_mps2 ({:?})",
+                    self.comfort_deceleration_mps2
+                ),
+            });
+        }
+        Ok(())
+    }
+
+    /// The ACC's acceleration at speed `v` with set speed `set_speed`, behind
+    /// `leader` = (net gap, leader speed), or on a free road.
+    pub fn acceleration(&self, v: f64, set_speed: f64, leader: Option<(f64, f64)>) -> f64 {
+        let cruise = self.cruise_gain * (set_speed - v);
+        let Some((gap, leader_v)) = leader else {
+            return cruise.clamp(-self.comfort_deceleration_mps2, self.max_acceleration_mps2);
+        };
+        let follow = self.gap_gain * (gap - self.standstill_gap_m - self.time_gap_s * v)
+            + self.speed_gain * (leader_v - v);
+        let comfortable = follow
+            .min(cruise)
+            .clamp(-self.comfort_deceleration_mps2, self.max_acceleration_mps2);
+        let closing = v - leader_v;
+        if closing <= 0.0 {
+            return comfortable;
+        }
+        // The deceleration that matches the leader's speed just at the standstill gap.
+        let room = (gap - self.standstill_gap_m).max(1e-3);
+        let needed = closing * closing / (2.0 * room);
+        if needed > self.comfort_deceleration_mps2 {
+            -needed.min(self.emergency_deceleration_mps2)
+        } else {
+            comfortable
+        }
+    }
+}
+
+/// The vehicle the ego's ACC follows: the nearest vehicle ahead (front bumper
+/// ahead of the ego's) in any lane the ego's body occupies, as (net gap, speed).
+pub fn acc_leader(scene: &Scene) -> Option<(f64, f64)> {
+    let ego = scene.ego()?;
+    let road = scene.road();
+    scene
+        .vehicles()
+        .iter()
+        .filter(|v| !matches!(v.driver, Driver::External { .. }))
+        .filter(|v| v.state.s > ego.state.s && road.occupies(ego.state.l, ego.width, v.lane))
+        .min_by(|a, b| a.state.s.total_cmp(&b.state.s))
+        .map(|v| (v.rear() - ego.state.s, v.state.v))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_defaults_are_valid_and_bad_values_name_their_field() {
+        AccConfig::default().validate("planning.acc").unwrap();
+        let bad = AccConfig {
+            time_gap_s: -1.0,
+            ..AccConfig::default()
+        };
+        let err = bad.validate("planning.acc").unwrap_err().to_string();
+        assert!(err.contains("planning.acc.time_gap_s"), "{err}");
+        assert!(err.contains("-1.0"), "{err}");
+        let bad = AccConfig {
+            emergency_deceleration_mps2: 2.0,
+            ..AccConfig::default()
+        };
+        let err = bad.validate("planning.acc").unwrap_err().to_string();
+        assert!(err.contains("emergency_deceleration_mps2"), "{err}");
+    }
+
+    #[test]
+    fn the_equilibrium_gap_has_zero_acceleration() {
+        let acc = AccConfig::default();
+        for v in [5.0, 15.0, 30.0] {
+            let gap = acc.standstill_gap_m + acc.time_gap_s * v;
+            // Set speed above v, so that cruising does not cap the law.
+            let a = acc.acceleration(v, v + 5.0, Some((gap, v)));
+            assert!(a.abs() < 1e-12, "v {v}: {a}");
+        }
+    }
+
+    #[test]
+    fn a_free_road_returns_to_the_set_speed_and_respects_the_limits() {
+        let acc = AccConfig::default();
+        assert!(acc.acceleration(20.0, 20.0, None).abs() < 1e-12);
+        assert!((acc.acceleration(10.0, 30.0, None) - acc.max_acceleration_mps2).abs() < 1e-12);
+        assert!(acc.acceleration(30.0, 20.0, Some((1000.0, 30.0))) < 0.0);
+    }
+
+    #[test]
+    fn a_fast_approach_brakes_beyond_comfort_up_to_the_emergency_limit() {
+        let acc = AccConfig::default();
+        // Closing at 10 m/s with 12 m of room: (10^2) / (2 * 10) = 5 m/s^2 needed.
+        let a = acc.acceleration(20.0, 20.0, Some((12.0, 10.0)));
+        assert!((a + 5.0).abs() < 1e-12, "{a}");
+        // Closing at 20 m/s with 5 m: beyond the emergency limit, which caps it.
+        let a = acc.acceleration(30.0, 30.0, Some((7.0, 10.0)));
+        assert!((a + acc.emergency_deceleration_mps2).abs() < 1e-12, "{a}");
+    }
+}
