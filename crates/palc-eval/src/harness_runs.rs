@@ -177,6 +177,9 @@ impl Observer for RowRecorder {
             max_deviation_m: record.max_deviation_m,
             times_s: record.times.parts(),
             learning_error: None,
+            safety: record.safety,
+            user_safety: record.user_safety,
+            safety_refusal: record.safety_refusal,
         });
     }
 

@@ -43,6 +43,7 @@ pub mod plan;
 pub mod report;
 pub mod results;
 pub mod runner;
+pub mod safety_report;
 pub mod stats;
 pub mod views;
 

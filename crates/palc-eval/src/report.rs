@@ -61,6 +61,7 @@ pub fn render(input: &ReportInput) -> String {
         user_section(&mut out, input, user);
     }
     claims_section(&mut out);
+    crate::safety_report::section(&mut out, input.rows, input.methods);
     refusals(&mut out, input.rows);
     learning_failures(&mut out, input);
     timing_section(&mut out, input);

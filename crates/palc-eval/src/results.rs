@@ -60,7 +60,18 @@ pub struct Iteration {
     /// Why the lesson of this lane change could not be learned, if it could not.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub learning_error: Option<String>,
+    /// Safety of the steps the system drove.
+    #[serde(default)]
+    pub safety: SafetyMetrics,
+    /// Safety of the steps the user drove after a takeover.
+    #[serde(default)]
+    pub user_safety: SafetyMetrics,
+    /// Why the safety layer refused the learned plan, if it did.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub safety_refusal: Option<Violation>,
 }
+
+use palc_harness::{SafetyMetrics, Violation};
 
 /// Names of the parts of [`Iteration::times_s`].
 pub const PART_NAMES: [&str; 5] = palc_harness::Timings::PART_NAMES;
@@ -130,6 +141,19 @@ impl RunRow {
         outcome.counted_takeovers(self.takeovers, self.cap)
     }
 
+    /// Lane changes of the run for which `predicate` holds.
+    pub fn lane_changes_where(&self, predicate: impl Fn(&Iteration) -> bool) -> usize {
+        self.iterations.iter().filter(|i| predicate(i)).count()
+    }
+
+    /// The smallest `measure` of the system-driven steps over the run's lane changes.
+    pub fn min_of(&self, measure: impl Fn(&SafetyMetrics) -> Option<f64>) -> Option<f64> {
+        self.iterations
+            .iter()
+            .filter_map(|i| measure(&i.safety))
+            .min_by(f64::total_cmp)
+    }
+
     /// Whether the run personalized.
     pub fn personalized(&self) -> bool {
         self.status == Status::Personalized
@@ -179,6 +203,14 @@ struct CsvRow<'a> {
     ceiling_takeover_rate: Option<f64>,
     mean_compute_per_iteration_s: Option<f64>,
     experience_from: Option<usize>,
+    collisions: usize,
+    rss_violations: usize,
+    user_rss_violations: usize,
+    safety_refusals: usize,
+    min_gap_preceding_m: Option<f64>,
+    min_gap_target_lead_m: Option<f64>,
+    min_gap_target_lag_m: Option<f64>,
+    min_ttc_s: Option<f64>,
     note: String,
 }
 
@@ -215,6 +247,23 @@ pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> Result<(), EvalEr
             ceiling_takeover_rate: row.ceiling_takeover_rate,
             mean_compute_per_iteration_s: row.mean_compute_s(),
             experience_from: row.spec.experience_from,
+            collisions: row.lane_changes_where(|i| i.safety.collision),
+            rss_violations: row.lane_changes_where(|i| i.safety.rss_violations > 0),
+            user_rss_violations: row.lane_changes_where(|i| !i.user_safety.is_safe()),
+            safety_refusals: row.lane_changes_where(|i| i.safety_refusal.is_some()),
+            min_gap_preceding_m: row.min_of(|s| s.min_gap_preceding_m),
+            min_gap_target_lead_m: row.min_of(|s| s.min_gap_target_lead_m),
+            min_gap_target_lag_m: row.min_of(|s| s.min_gap_target_lag_m),
+            min_ttc_s: row.min_of(|s| {
+                [
+                    s.min_ttc_preceding_s,
+                    s.min_ttc_target_lead_s,
+                    s.min_ttc_target_lag_s,
+                ]
+                .into_iter()
+                .flatten()
+                .min_by(f64::total_cmp)
+            }),
             note,
         })?;
     }

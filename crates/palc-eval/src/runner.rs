@@ -191,6 +191,9 @@ pub(crate) mod tests {
                         0.005 * spec.dt.unwrap_or(0.1) * 10.0,
                     ],
                     learning_error: None,
+                    safety: Default::default(),
+                    user_safety: Default::default(),
+                    safety_refusal: None,
                 })
                 .collect();
             let dt = spec.dt.unwrap_or(0.1);

@@ -31,6 +31,12 @@ use crate::HarnessError;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct AccConfig {
+    /// Whether the ACC drives the ego. Off by default: the ego then holds its speed,
+    /// as in the paper (the evaluation's scenes and figures). On, an ego behind a
+    /// vehicle as slow as the target lane slows to its speed and drops back to seek
+    /// a gap, and the users' headway start rules no longer describe that situation
+    /// (docs/paper-mapping.md, "Ego longitudinal behaviour", an open problem).
+    pub enabled: bool,
     /// Time gap `T` kept to the vehicle ahead (s). 0.8 s is the shortest that
     /// ISO 15622 lets an ACC offer; it must be shorter than every user's start
     /// headway (the paper's shortest is 1.15 s), or the users waiting behind the
@@ -50,11 +56,17 @@ pub struct AccConfig {
     pub comfort_deceleration_mps2: f64,
     /// Emergency deceleration (m/s²), used only when `b` cannot avoid the vehicle ahead.
     pub emergency_deceleration_mps2: f64,
+    /// How much slower than the target lane's traffic the ego drives while the gap
+    /// beside it is not safe (m/s): it drops back until a safe gap comes alongside.
+    /// Behind a vehicle as slow as the target lane, an ego that only follows it would
+    /// keep its place beside the same target-lane vehicles for ever.
+    pub gap_seeking_speed_mps: f64,
 }
 
 impl Default for AccConfig {
     fn default() -> Self {
         Self {
+            enabled: false,
             time_gap_s: 0.8,
             standstill_gap_m: 2.0,
             gap_gain: 0.15,
@@ -63,6 +75,7 @@ impl Default for AccConfig {
             max_acceleration_mps2: 1.5,
             comfort_deceleration_mps2: 3.0,
             emergency_deceleration_mps2: 8.0,
+            gap_seeking_speed_mps: 2.0,
         }
     }
 }
@@ -100,6 +113,15 @@ impl AccConfig {
                 });
             }
         }
+        if !(self.gap_seeking_speed_mps.is_finite()
+            && (0.0..=10.0).contains(&self.gap_seeking_speed_mps))
+        {
+            return Err(HarnessError::InvalidConfig {
+                field: format!("{table}.gap_seeking_speed_mps"),
+                value: self.gap_seeking_speed_mps,
+                bound: "a value in [0, 10.0]".to_owned(),
+            });
+        }
         if !(self.standstill_gap_m.is_finite() && (0.0..=50.0).contains(&self.standstill_gap_m)) {
             return Err(HarnessError::InvalidConfig {
                 field: format!("{table}.standstill_gap_m"),
@@ -121,8 +143,11 @@ impl AccConfig {
     }
 
     /// The ACC's acceleration at speed `v` with set speed `set_speed`, behind
-    /// `leader` = (net gap, leader speed), or on a free road.
+    /// `leader` = (net gap, leader speed), or on a free road; 0 when it is off.
     pub fn acceleration(&self, v: f64, set_speed: f64, leader: Option<(f64, f64)>) -> f64 {
+        if !self.enabled {
+            return 0.0;
+        }
         let cruise = self.cruise_gain * (set_speed - v);
         let Some((gap, leader_v)) = leader else {
             return cruise.clamp(-self.comfort_deceleration_mps2, self.max_acceleration_mps2);
@@ -165,6 +190,19 @@ pub fn acc_leader(scene: &Scene) -> Option<(f64, f64)> {
 mod tests {
     use super::*;
 
+    fn on() -> AccConfig {
+        AccConfig {
+            enabled: true,
+            ..AccConfig::default()
+        }
+    }
+
+    #[test]
+    fn off_the_ego_holds_its_speed() {
+        let acc = AccConfig::default();
+        assert_eq!(acc.acceleration(20.0, 25.0, Some((5.0, 10.0))), 0.0);
+    }
+
     #[test]
     fn the_defaults_are_valid_and_bad_values_name_their_field() {
         AccConfig::default().validate("planning.acc").unwrap();
@@ -185,7 +223,7 @@ mod tests {
 
     #[test]
     fn the_equilibrium_gap_has_zero_acceleration() {
-        let acc = AccConfig::default();
+        let acc = on();
         for v in [5.0, 15.0, 30.0] {
             let gap = acc.standstill_gap_m + acc.time_gap_s * v;
             // Set speed above v, so that cruising does not cap the law.
@@ -196,7 +234,7 @@ mod tests {
 
     #[test]
     fn a_free_road_returns_to_the_set_speed_and_respects_the_limits() {
-        let acc = AccConfig::default();
+        let acc = on();
         assert!(acc.acceleration(20.0, 20.0, None).abs() < 1e-12);
         assert!((acc.acceleration(10.0, 30.0, None) - acc.max_acceleration_mps2).abs() < 1e-12);
         assert!(acc.acceleration(30.0, 20.0, Some((1000.0, 30.0))) < 0.0);
@@ -204,7 +242,7 @@ mod tests {
 
     #[test]
     fn a_fast_approach_brakes_beyond_comfort_up_to_the_emergency_limit() {
-        let acc = AccConfig::default();
+        let acc = on();
         // Closing at 10 m/s with 12 m of room: (10^2) / (2 * 10) = 5 m/s^2 needed.
         let a = acc.acceleration(20.0, 20.0, Some((12.0, 10.0)));
         assert!((a + 5.0).abs() < 1e-12, "{a}");

@@ -32,7 +32,9 @@ pub fn problem(setup: &Setup, weights: Weights, bounds: Vec<Option<LateralBound>
         preceding: setup.preceding[..k].iter().map(position).collect(),
         adjacent: setup.adjacent[..k].iter().map(position).collect(),
         terminal: Terminal {
-            s: Some(setup.lane_keeping[k][0]),
+            // Under the ACC the plan ends where the ego keeping its lane would, so
+            // that it does not run ahead of it between start and end.
+            s: setup.acc.enabled.then(|| setup.lane_keeping[k][0]),
             v: speed(k),
             l: setup.target_l,
         },

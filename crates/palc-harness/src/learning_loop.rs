@@ -114,7 +114,9 @@ impl LearningLoop {
             .weights(&standard, setup.horizon, setup.dt);
         let fallback_plan = planner.plan(&problem(&setup, standard_weights, Vec::new()))?;
         let fallback_safety = plan_safety(&setup, &fallback_plan)?;
-        if let Some(violation) = unsafe_because(&fallback_safety) {
+        if let Some(violation) = unsafe_because(&fallback_safety)
+            && config.planning.safety.enforce
+        {
             return Err(HarnessError::Scenario {
                 scenario: config.label(),
                 reason: format!(
@@ -260,12 +262,12 @@ impl LearningLoop {
         &self.next_plan
     }
 
-    /// The safety layer: the learned plan if it is safe, else the standard ALC's
+    /// The safety layer (with `safety.enforce`): the learned plan if it is safe, else the standard ALC's
     /// (checked safe when the loop was prepared), with the predicted safety of the
     /// plan returned and the reason for a refusal.
     fn checked_plan(&self) -> Result<(Plan, SafetyMetrics, Option<Violation>), HarnessError> {
         let predicted = plan_safety(&self.setup, &self.next_plan)?;
-        match unsafe_because(&predicted) {
+        match unsafe_because(&predicted).filter(|_| self.setup.safety.enforce) {
             None => Ok((self.next_plan.clone(), predicted, None)),
             Some(violation) => {
                 let fallback = plan_safety(&self.setup, &self.fallback_plan)?;

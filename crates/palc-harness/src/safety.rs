@@ -32,6 +32,13 @@ use crate::HarnessError;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SafetyConfig {
+    /// Whether the safety layer acts: refuses unsafe plans (driving the standard
+    /// ALC's instead), makes the standard ALC wait for safe target-lane gaps and
+    /// refuses scenes without a safe lane change. Off by default: in the paper's
+    /// scenes, where the ego closes on the preceding vehicle at constant speed, no
+    /// lane change keeps the RSS distance to it (docs/paper-mapping.md, "Safety").
+    /// The measures are taken either way.
+    pub enforce: bool,
     /// Response time `ρ` of the rear vehicle (s).
     pub response_time_s: f64,
     /// Largest acceleration `a_acc` of the rear vehicle during its response (m/s²).
@@ -48,6 +55,7 @@ impl Default for SafetyConfig {
     /// vehicles of one class that brake alike (docs/paper-mapping.md, "Safety").
     fn default() -> Self {
         Self {
+            enforce: false,
             response_time_s: 0.5,
             max_acceleration_mps2: 1.5,
             min_braking_mps2: 6.0,

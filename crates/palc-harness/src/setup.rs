@@ -37,9 +37,9 @@ pub struct PlanningConfig {
     /// The standard ALC starts no earlier than this long after the latest of the
     /// paper's three styles (s): a conservative system waits until every style would
     /// have gone, also when a user's start is set by a gap on the target lane.
-    /// Being the system, it also waits until both target-lane gaps stay at least the
-    /// safe distance of `safety` over its whole lane change, as predicted with the
-    /// ego keeping its lane.
+    /// With `safety.enforce`, it also waits until both target-lane gaps stay at least
+    /// the safe distance over its whole lane change, as predicted with the ego
+    /// keeping its lane.
     pub standard_alc_min_delay_s: f64,
     /// Lateral position of the target lane's centre (m).
     pub target_l: f64,
@@ -194,7 +194,7 @@ impl Setup {
                 trigger = Some(step);
                 break;
             }
-            lane_keeping_step(&mut scene, config, set_speed)?;
+            lane_keeping_step(&mut scene, config, set_speed, false)?;
         }
         if trigger.is_none() {
             return Err(scenario_error(format!(
@@ -233,7 +233,7 @@ impl Setup {
                 origin_s,
             ));
             if step < window {
-                lane_keeping_step(&mut rollout, config, set_speed)?;
+                lane_keeping_step(&mut rollout, config, set_speed, true)?;
             }
         }
 
@@ -259,9 +259,10 @@ impl Setup {
         let earliest = own_start.max(latest_user + delay);
         let standard_start_step = (earliest..=window.saturating_sub(duration))
             .find(|&start| {
-                situations[start..=start + duration]
-                    .iter()
-                    .all(|s| target_gaps_safe(s, &config.safety))
+                !config.safety.enforce
+                    || situations[start..=start + duration]
+                        .iter()
+                        .all(|s| target_gaps_safe(s, &config.safety))
             })
             .ok_or_else(|| {
                 scenario_error(format!(
@@ -370,14 +371,31 @@ fn target_gaps_safe(situation: &Situation, safety: &SafetyConfig) -> bool {
     lead_ok && lag_ok
 }
 
-/// One simulation step with the ego keeping its lane under its ACC.
+/// One simulation step with the ego keeping its lane under its ACC; after the
+/// trigger (`seeking_gap`), the ego also drops back while the gap beside it is unsafe.
 fn lane_keeping_step(
     scene: &mut Scene,
     config: &PlanningConfig,
     set_speed: f64,
+    seeking_gap: bool,
 ) -> Result<(), HarnessError> {
     let ego = scene.ego().map(|e| e.state).unwrap_or_default();
-    let acceleration = config.acc.acceleration(ego.v, set_speed, acc_leader(scene));
+    let mut acceleration = config.acc.acceleration(ego.v, set_speed, acc_leader(scene));
+    // Gap seeking: while the gap beside is not safe, drop back below the target
+    // lane's speed so that the next gap comes alongside.
+    let seen = situation(scene);
+    if seeking_gap && config.acc.enabled && !target_gaps_safe(&seen, &config.safety) {
+        let flow = [seen.target_lead_speed, seen.target_lag_speed]
+            .into_iter()
+            .flatten()
+            .min_by(f64::total_cmp);
+        if let Some(flow) = flow {
+            let target = (flow - config.acc.gap_seeking_speed_mps).max(0.0);
+            let drop_back = (config.acc.cruise_gain * (target - ego.v))
+                .max(-config.acc.comfort_deceleration_mps2);
+            acceleration = acceleration.min(drop_back);
+        }
+    }
     let moved = ballistic_step(ego.v, acceleration, config.dt);
     let next = EgoState {
         s: ego.s + moved.distance,

@@ -25,10 +25,8 @@ pub struct Style {
     /// Duration of the lateral move from lane centre to lane centre (s).
     pub lane_change_duration_s: f64,
     /// Smallest net gap to the leader on the target lane that the user accepts,
-    /// as a time gap at the ego's speed (s); the gap to the follower on the target
-    /// lane must be as long, as a time gap at the follower's speed. Not in the
-    /// paper: it makes the paper's congestion levels matter (see
-    /// docs/paper-mapping.md).
+    /// as a time gap at the ego's speed (s). Not in the paper: it makes the
+    /// paper's congestion levels matter (see docs/paper-mapping.md).
     #[serde(default = "Style::default_min_lead_gap_s")]
     pub min_lead_gap_s: f64,
 }
@@ -180,12 +178,8 @@ impl Style {
         let lead_ok = situation
             .target_lead_gap_m
             .is_none_or(|gap| gap >= self.min_lead_gap_s * situation.ego_speed);
-        // Nobody starts a lane change into a vehicle alongside, nor just ahead of
-        // one: the gap behind must be as long, in time at the follower's speed, as
-        // the gap ahead the user accepts.
-        let lag_ok = situation.target_lag_gap_m.is_none_or(|gap| {
-            gap > 0.0 && gap >= self.min_lead_gap_s * situation.target_lag_speed.unwrap_or(0.0)
-        });
+        // Nobody starts a lane change into a vehicle alongside.
+        let lag_ok = situation.target_lag_gap_m.is_none_or(|gap| gap > 0.0);
         // Nor behind a preceding vehicle it has already reached.
         let behind = situation.time_headway_s > 0.0;
         behind && situation.time_headway_s <= self.time_headway_s && lead_ok && lag_ok

@@ -1,0 +1,112 @@
+//! REPORT.md's safety section: collisions, RSS safe-distance violations, the
+//! safety layer's refusals and the distributions of the smallest gaps and times to
+//! collision, per experiment and method (docs/paper-mapping.md, "Safety").
+
+use std::fmt::Write as _;
+
+use palc_harness::{Method, SafetyMetrics};
+
+use crate::plan::Experiment;
+use crate::results::{Iteration, RunRow};
+
+/// Writes the section.
+pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
+    let _ = writeln!(out, "## Safety of every executed lane change\n");
+    let _ = writeln!(
+        out,
+        "Every lane change is measured step by step in the scene: the net gap and time to collision \
+         to the preceding vehicle and to the target lane's lead and lag vehicles (while the ego \
+         occupies their lane), footprint overlaps (collisions) and the RSS longitudinal safe distance \
+         (response 0.5 s, 1.5 m/s² during it, 6 m/s² braking for both vehicles; \
+         `[planning.safety]`). *System* counts the steps the system drove (the plan up to a \
+         takeover); *user* the steps the simulated user drove after a takeover. The safety layer \
+         checks every plan before it is driven and drives the standard ALC's plan instead of an \
+         unsafe one (a refusal).\n"
+    );
+    let _ = writeln!(
+        out,
+        "| experiment | method | lane changes | system: collisions | system: RSS violations | user: collisions | user: RSS violations | refusals | min gap preceding, p5 / min (m) | min gap target lead, p5 / min (m) | min gap target lag, p5 / min (m) | min TTC, p5 / min (s) |"
+    );
+    let _ = writeln!(
+        out,
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+    );
+    for experiment in [Experiment::Grid, Experiment::Transfer, Experiment::Timing] {
+        for &method in methods {
+            let iterations: Vec<&Iteration> = rows
+                .iter()
+                .filter(|r| r.spec.experiment == experiment && r.spec.method == method)
+                .flat_map(|r| &r.iterations)
+                .collect();
+            if iterations.is_empty() {
+                continue;
+            }
+            let count = |f: &dyn Fn(&Iteration) -> bool| iterations.iter().filter(|i| f(i)).count();
+            let distribution = |f: &dyn Fn(&SafetyMetrics) -> Option<f64>| {
+                let values: Vec<f64> = iterations.iter().filter_map(|i| f(&i.safety)).collect();
+                low_tail(values)
+            };
+            let _ = writeln!(
+                out,
+                "| {} | `{}` | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                experiment.name(),
+                method.name(),
+                iterations.len(),
+                count(&|i| i.safety.collision),
+                count(&|i| i.safety.rss_violations > 0),
+                count(&|i| i.user_safety.collision),
+                count(&|i| i.user_safety.rss_violations > 0),
+                count(&|i| i.safety_refusal.is_some()),
+                distribution(&|s| s.min_gap_preceding_m),
+                distribution(&|s| s.min_gap_target_lead_m),
+                distribution(&|s| s.min_gap_target_lag_m),
+                distribution(&|s| {
+                    [
+                        s.min_ttc_preceding_s,
+                        s.min_ttc_target_lead_s,
+                        s.min_ttc_target_lag_s,
+                    ]
+                    .into_iter()
+                    .flatten()
+                    .min_by(f64::total_cmp)
+                }),
+            );
+        }
+    }
+    let _ = writeln!(out);
+    let first_user_violation = rows
+        .iter()
+        .flat_map(|r| r.iterations.iter().map(move |i| (r, i)))
+        .find_map(|(r, i)| i.user_safety.first_violation.map(|v| (r, v)));
+    if let Some((row, violation)) = first_user_violation {
+        let _ = writeln!(
+            out,
+            "A user-driven violation, for example (`{}`): {violation}. The simulated user's own \
+             lane change is the user's choice; the system neither plans nor drives it.\n",
+            row.spec.label()
+        );
+    }
+}
+
+/// `p5 / min` of `values` with one decimal, `-` when there are none.
+fn low_tail(mut values: Vec<f64>) -> String {
+    if values.is_empty() {
+        return "-".to_owned();
+    }
+    values.sort_by(f64::total_cmp);
+    let p5 = values[((values.len() - 1) as f64 * 0.05).round() as usize];
+    format!("{p5:.1} / {:.1}", values[0])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_low_tail_is_the_fifth_percentile_and_the_minimum() {
+        assert_eq!(low_tail(Vec::new()), "-");
+        let values: Vec<f64> = (0..=100).map(f64::from).rev().collect();
+        assert_eq!(low_tail(values), "5.0 / 0.0");
+        assert_eq!(low_tail(vec![3.25]), "3.2 / 3.2");
+    }
+}

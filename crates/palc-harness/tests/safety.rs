@@ -1,0 +1,215 @@
+//! The ego's ACC and the safety measures in small scenes built by hand: a braking
+//! leader the ACC must not hit, a lag vehicle closing on a lane change that the
+//! measures must flag, and the record's new fields through JSON.
+
+use palc_harness::{AccConfig, SafetyConfig, SafetyMetrics, SafetyMonitor, acc_leader};
+use palc_traffic::{
+    Driver, EgoState, IdmParams, Lane, Road, Scene, SpeedProfile, Vehicle, VehicleId, VehicleState,
+    ballistic_step,
+};
+
+fn vehicle(id: u32, lane: Lane, s: f64, v: f64, driver: Driver) -> Vehicle {
+    let road = Road::paper();
+    Vehicle {
+        id: VehicleId(id),
+        length: 5.0,
+        width: 1.8,
+        lane,
+        state: VehicleState {
+            s,
+            l: road.lane_centre(lane),
+            v,
+            a: 0.0,
+            heading: 0.0,
+        },
+        driver,
+    }
+}
+
+fn ego(s: f64, v: f64) -> Vehicle {
+    vehicle(
+        0,
+        Lane(0),
+        s,
+        v,
+        Driver::External {
+            stand_in: IdmParams::treiber_2000(v),
+        },
+    )
+}
+
+/// Drives the ego with `step` for `steps` steps of 0.1 s, measuring every step.
+fn drive(
+    mut scene: Scene,
+    steps: usize,
+    mut step: impl FnMut(&Scene) -> EgoState,
+) -> SafetyMetrics {
+    let mut monitor = SafetyMonitor::new(SafetyConfig::default(), &scene, 3.5);
+    monitor.observe(0, &scene);
+    for i in 1..=steps {
+        let next = step(&scene);
+        scene.step(0.1, next).expect("a valid step");
+        monitor.observe(i, &scene);
+    }
+    monitor.metrics()
+}
+
+#[test]
+fn the_acc_does_not_hit_a_leader_that_brakes_hard_to_a_stop() {
+    let acc = AccConfig {
+        enabled: true,
+        ..AccConfig::default()
+    };
+    // The leader brakes at -4 m/s^2 from 25 m/s to a stop, 2 s into the scene.
+    let profile = SpeedProfile::new(vec![(0.0, 25.0), (2.0, 25.0), (8.25, 0.0)]).unwrap();
+    let scene = Scene::new(
+        Road::paper(),
+        vec![
+            ego(0.0, 25.0),
+            vehicle(1, Lane(0), 27.0, 25.0, Driver::Scripted(profile)),
+        ],
+        9.0,
+    )
+    .unwrap();
+    let metrics = drive(scene, 200, |scene| {
+        let e = scene.ego().unwrap().state;
+        let a = acc.acceleration(e.v, 25.0, acc_leader(scene));
+        let moved = ballistic_step(e.v, a, 0.1);
+        EgoState {
+            s: e.s + moved.distance,
+            l: e.l,
+            v: moved.speed,
+            heading: 0.0,
+        }
+    });
+    assert!(!metrics.collision, "{metrics:?}");
+}
+
+#[test]
+fn an_ego_that_holds_its_speed_behind_the_same_leader_collides_and_is_flagged() {
+    let profile = SpeedProfile::new(vec![(0.0, 25.0), (2.0, 25.0), (8.25, 0.0)]).unwrap();
+    let scene = Scene::new(
+        Road::paper(),
+        vec![
+            ego(0.0, 25.0),
+            vehicle(1, Lane(0), 27.0, 25.0, Driver::Scripted(profile)),
+        ],
+        9.0,
+    )
+    .unwrap();
+    let metrics = drive(scene, 100, |scene| {
+        let e = scene.ego().unwrap().state;
+        EgoState {
+            s: e.s + e.v * 0.1,
+            l: e.l,
+            v: e.v,
+            heading: 0.0,
+        }
+    });
+    assert!(metrics.collision);
+    assert!(metrics.rss_violations > 0);
+    assert!(!metrics.is_safe());
+}
+
+#[test]
+fn cutting_in_ahead_of_a_closing_lag_vehicle_is_a_violation_of_the_lag_gap() {
+    // A lag vehicle on the target lane, 8 m behind the ego's rear and 5 m/s faster.
+    let scene = Scene::new(
+        Road::paper(),
+        vec![
+            ego(100.0, 20.0),
+            vehicle(
+                2,
+                Lane(1),
+                87.0,
+                25.0,
+                Driver::Idm(IdmParams::treiber_2000(25.0)),
+            ),
+        ],
+        9.0,
+    )
+    .unwrap();
+    let mut i = 0;
+    let metrics = drive(scene, 30, |scene| {
+        i += 1;
+        let e = scene.ego().unwrap().state;
+        // Straight to the target lane in 2 s at constant speed.
+        let l = (3.5 * i as f64 / 20.0).min(3.5);
+        EgoState {
+            s: e.s + e.v * 0.1,
+            l,
+            v: e.v,
+            heading: 0.0,
+        }
+    });
+    let violation = metrics.first_violation.expect("a violation");
+    assert_eq!(violation.vehicle, 2);
+    assert_eq!(format!("{:?}", violation.role), "TargetLag");
+    assert!(violation.gap_m < violation.safe_distance_m);
+    assert!(metrics.min_gap_target_lag_m.is_some());
+    assert!(metrics.min_ttc_target_lag_s.is_some());
+    let text = violation.to_string();
+    assert!(
+        text.starts_with("unsafe gap: target-lane lag vehicle 2 at"),
+        "{text}"
+    );
+}
+
+#[test]
+fn a_lane_change_away_from_everyone_is_safe() {
+    let scene = Scene::new(
+        Road::paper(),
+        vec![
+            ego(100.0, 20.0),
+            vehicle(
+                2,
+                Lane(1),
+                20.0,
+                20.0,
+                Driver::Idm(IdmParams::treiber_2000(20.0)),
+            ),
+            vehicle(
+                3,
+                Lane(0),
+                200.0,
+                20.0,
+                Driver::Idm(IdmParams::treiber_2000(20.0)),
+            ),
+        ],
+        9.0,
+    )
+    .unwrap();
+    let mut i = 0;
+    let metrics = drive(scene, 30, |scene| {
+        i += 1;
+        let e = scene.ego().unwrap().state;
+        EgoState {
+            s: e.s + e.v * 0.1,
+            l: (3.5 * i as f64 / 20.0).min(3.5),
+            v: e.v,
+            heading: 0.0,
+        }
+    });
+    assert!(metrics.is_safe(), "{metrics:?}");
+}
+
+#[test]
+fn safety_metrics_round_trip_through_json() {
+    let metrics = SafetyMetrics {
+        min_gap_preceding_m: Some(12.5),
+        min_ttc_target_lag_s: Some(3.25),
+        collision: false,
+        rss_violations: 2,
+        first_violation: Some(palc_harness::Violation {
+            step: 37,
+            role: palc_harness::safety::Role::TargetLag,
+            vehicle: 4,
+            gap_m: 6.1,
+            safe_distance_m: 14.2,
+        }),
+        ..SafetyMetrics::default()
+    };
+    let text = serde_json::to_string(&metrics).unwrap();
+    let back: SafetyMetrics = serde_json::from_str(&text).unwrap();
+    assert_eq!(back, metrics);
+}
