@@ -207,7 +207,7 @@ proptest! {
 
     #[test]
     fn fuzz_plan_problem(text in mutated(PLAN)) {
-        if let Ok(input) = serde_json::from_str::<PlanInput>(&text) {
+        if let Ok(input) = crate::parse::json::<PlanInput>(text.as_bytes()) {
             if let Ok(mut planner) = Planner::new(input.config) {
                 if let Ok(plan) = planner.plan(&input.problem) {
                     no_nan(&plan)?;
@@ -235,7 +235,7 @@ fn the_shipped_examples_parse() {
         Scene::from_config(&config, 0).unwrap();
     }
     EvalConfig::from_toml_str(REPRODUCE).unwrap();
-    let input: PlanInput = serde_json::from_str(PLAN).unwrap();
+    let input: PlanInput = crate::parse::json(PLAN.as_bytes()).unwrap();
     Planner::new(input.config)
         .unwrap()
         .plan(&input.problem)
