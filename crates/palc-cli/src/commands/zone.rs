@@ -258,7 +258,7 @@ impl std::fmt::Display for TooManyRows {
 impl std::error::Error for TooManyRows {}
 
 /// Reads the feature columns of `set` (by name) and, if `with_label`, the `y` column.
-fn csv_rows(
+pub(crate) fn csv_rows(
     reader: impl Read,
     set: FeatureSet,
     with_label: bool,
