@@ -8,6 +8,13 @@
 //!
 //! The default budget is small (proptest's `PROPTEST_CASES`, 64 cases here); run
 //! `PROPTEST_CASES=100000 cargo test -p palc-cli --release fuzz` for a long run.
+//!
+//! Long run recorded (release, one property at a time, 100,000 cases each, on a
+//! two-core machine shared with other builds): every property passed, no failure
+//! found. Wall times: learn config 4.6 s, test-bed config 4.1 s, platoon config
+//! 3.4 s, evaluation config 10.6 s, plan problem 11.9 s, zone config 16.6 s, zone
+//! model 3.4 s, zone samples CSV 17.9 s, zone points CSV 8.2 s. Most mutated inputs
+//! are refused by the parser or the validation, so these times are mostly parsing.
 
 use palc_eval::EvalConfig;
 use palc_harness::LearnConfig;
