@@ -1,20 +1,36 @@
 //! Fuzz-style property tests of every input format `palc` reads: random bytes,
 //! random truncations and random field mutations of the shipped examples in
-//! `configs/`. Each parser must return a typed error or a value that is valid and
-//! carries no NaN; none may panic.
+//! `configs/` (the learn, test-bed, platoon and evaluation configs, the plan problem,
+//! the zone config, the zone model that `palc zone fit` writes for the zone example,
+//! and the samples and points CSVs). Each parser must return a typed error or a
+//! value that is valid and carries no NaN; none may panic. A zone model or points
+//! file that parses is also classified: every posterior must be a probability.
 //!
 //! The default budget is small (proptest's `PROPTEST_CASES`, 64 cases here); run
 //! `PROPTEST_CASES=100000 cargo test -p palc-cli --release fuzz` for a long run.
+//!
+//! Long run recorded (release, one property at a time, 100,000 cases each, on a
+//! two-core machine shared with other builds): every property passed, no failure
+//! found. Wall times: learn config 4.6 s, test-bed config 4.1 s, platoon config
+//! 3.4 s, evaluation config 10.6 s, plan problem 11.9 s, zone config 16.6 s, zone
+//! model 3.4 s, zone samples CSV 17.9 s, zone points CSV 8.2 s. Most mutated inputs
+//! are refused by the parser or the validation, so these times are mostly parsing.
 
 use palc_eval::EvalConfig;
 use palc_harness::LearnConfig;
 use palc_planner::Planner;
 use palc_traffic::{ScenarioConfig, Scene};
-use palc_zone_filter::{FeatureSet, ZoneModel};
+use std::sync::LazyLock;
+
+use palc_zone_filter::{FeatureSet, ZoneConfig, ZoneModel};
 use proptest::prelude::*;
 use proptest::test_runner::Config;
 
-use crate::commands::{plan::PlanInput, zone::samples_from_csv};
+use crate::commands::{
+    plan::PlanInput,
+    zone::{csv_rows, samples_from_csv},
+};
+use crate::parse;
 
 const LEARN: &str = include_str!("../../../configs/learn.toml");
 const TESTBED: &str = include_str!("../../../configs/testbed.toml");
@@ -22,6 +38,39 @@ const PLATOON: &str = include_str!("../../../configs/platoon.toml");
 const REPRODUCE: &str = include_str!("../../../configs/reproduce.toml");
 const PLAN: &str = include_str!("../../../configs/examples/plan-problem.json");
 const SAMPLES: &str = include_str!("../../../configs/examples/zone-samples.csv");
+const ZONE: &str = include_str!("../../../configs/examples/zone.toml");
+const POINTS: &str = include_str!("../../../configs/examples/zone-points.csv");
+
+/// The model that `palc zone fit` writes for the shipped zone example (config and
+/// samples), as pretty JSON: the example of the zone-model format.
+static MODEL: LazyLock<&'static str> = LazyLock::new(|| {
+    let model = ZoneModel::fit(example_zone_config(), &example_samples()).unwrap();
+    let mut json = serde_json::to_string_pretty(&model).unwrap();
+    json.push('\n');
+    Box::leak(json.into_boxed_str())
+});
+
+fn example_zone_config() -> ZoneConfig {
+    parse::toml(ZONE).unwrap()
+}
+
+fn example_samples() -> Vec<palc_zone_filter::Sample> {
+    samples_from_csv(SAMPLES.as_bytes(), FeatureSet::Paper).unwrap()
+}
+
+/// Classifies `rows` (row-major points of the model's features) as `palc zone
+/// classify` does; every posterior it returns must be a probability.
+fn classified(model: &ZoneModel, rows: &[f64]) -> Result<(), TestCaseError> {
+    let d = model.config().feature_set.dimension();
+    let mut p_safe = vec![0.0; rows.len() / d];
+    if rows.len() % d == 0 && model.posteriors_safe_into(rows, &mut p_safe).is_ok() {
+        prop_assert!(
+            p_safe.iter().all(|p| (0.0..=1.0).contains(p)),
+            "a posterior is no probability: {p_safe:?}"
+        );
+    }
+    Ok(())
+}
 
 /// Values that have broken parsers before: extremes, non-numbers, wrong types.
 const NASTY: &[&str] = &[
@@ -207,7 +256,7 @@ proptest! {
 
     #[test]
     fn fuzz_plan_problem(text in mutated(PLAN)) {
-        if let Ok(input) = serde_json::from_str::<PlanInput>(&text) {
+        if let Ok(input) = crate::parse::json::<PlanInput>(text.as_bytes()) {
             if let Ok(mut planner) = Planner::new(input.config) {
                 if let Ok(plan) = planner.plan(&input.problem) {
                     no_nan(&plan)?;
@@ -225,6 +274,45 @@ proptest! {
             }
         }
     }
+
+    #[test]
+    fn fuzz_zone_config(text in mutated(ZONE)) {
+        // As `palc zone fit --config`: parsed, validated, then fitted.
+        if let Ok(config) = parse::toml::<ZoneConfig>(&text) {
+            if config.validate().is_ok() {
+                no_nan(&config)?;
+                if let Ok(model) = ZoneModel::fit(config, &example_samples()) {
+                    no_nan(&model)?;
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn fuzz_zone_model(text in mutated(*MODEL)) {
+        // As `palc zone classify --model`: parsed (which checks and refits the
+        // statistics), then used on the example points.
+        if let Ok(model) = parse::json::<ZoneModel>(text.as_bytes()) {
+            no_nan(&model)?;
+            let rows: Vec<f64> = csv_rows(POINTS.as_bytes(), model.config().feature_set, false)
+                .unwrap()
+                .into_iter()
+                .flat_map(|(x, _)| x)
+                .collect();
+            classified(&model, &rows)?;
+        }
+    }
+
+    #[test]
+    fn fuzz_zone_points(text in mutated(POINTS)) {
+        static FITTED: LazyLock<ZoneModel> =
+            LazyLock::new(|| ZoneModel::fit(example_zone_config(), &example_samples()).unwrap());
+        if let Ok(rows) = csv_rows(text.as_bytes(), FeatureSet::Paper, false) {
+            no_nan(&rows)?;
+            let rows: Vec<f64> = rows.into_iter().flat_map(|(x, _)| x).collect();
+            classified(&FITTED, &rows)?;
+        }
+    }
 }
 
 #[test]
@@ -235,10 +323,14 @@ fn the_shipped_examples_parse() {
         Scene::from_config(&config, 0).unwrap();
     }
     EvalConfig::from_toml_str(REPRODUCE).unwrap();
-    let input: PlanInput = serde_json::from_str(PLAN).unwrap();
+    let input: PlanInput = crate::parse::json(PLAN.as_bytes()).unwrap();
     Planner::new(input.config)
         .unwrap()
         .plan(&input.problem)
         .unwrap();
-    samples_from_csv(SAMPLES.as_bytes(), FeatureSet::Paper).unwrap();
+    let model = ZoneModel::fit(example_zone_config(), &example_samples()).unwrap();
+    assert!(model.is_informative());
+    assert_eq!(parse::json::<ZoneModel>(MODEL.as_bytes()).unwrap(), model);
+    let points = csv_rows(POINTS.as_bytes(), FeatureSet::Paper, false).unwrap();
+    assert_eq!(points.len(), 18);
 }

@@ -14,6 +14,7 @@ mod commands;
 mod console;
 #[cfg(test)]
 mod fuzz;
+mod parse;
 
 /// Personalized automated lane change that learns from the driver's takeovers.
 #[derive(Debug, Parser)]

@@ -77,3 +77,21 @@ fn an_unknown_speed_case_lists_the_defined_ones() {
         "{stderr}"
     );
 }
+
+#[test]
+fn an_unknown_style_is_refused_with_the_file_and_the_field_path() {
+    let (output, out) = eval_with(
+        "eval-bad-style",
+        "styles = [\"aggressive\", \"neutral\", \"cautious\"]",
+        "styles = [\"reckless\"]",
+    );
+    assert!(!output.status.success());
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(
+        stderr.contains("reproduce.toml")
+            && stderr.contains("reckless")
+            && stderr.contains("grid.styles[0]"),
+        "{stderr}"
+    );
+    assert!(!out.exists(), "an output directory was created");
+}

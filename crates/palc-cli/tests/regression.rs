@@ -195,6 +195,34 @@ fn a_bad_dt_leaves_an_existing_csv_untouched() {
     );
 }
 
+#[test]
+fn too_many_traffic_steps_are_refused_before_the_output_is_touched() {
+    let dir = scratch("steps");
+    std::fs::write(dir.join("existing.csv"), "precious\n").unwrap();
+    let config = workspace_file("configs/testbed.toml");
+    // 10^6 steps (MAX_STEPS) are allowed; one more second at dt = 0.1 s is not.
+    let output = palc(
+        &[
+            "traffic",
+            "simulate",
+            "--config",
+            config.to_str().unwrap(),
+            "--duration",
+            "100001",
+            "--dt",
+            "0.1",
+            "--out",
+            "existing.csv",
+        ],
+        &dir,
+    );
+    fails_with(&output, &["1000010 steps", "at most 1000000 steps"]);
+    assert_eq!(
+        std::fs::read_to_string(dir.join("existing.csv")).unwrap(),
+        "precious\n"
+    );
+}
+
 /// The example plan problem with one replacement.
 fn plan_with(dir: &Path, from: &str, to: &str) -> Output {
     let text = read("configs/examples/plan-problem.json");

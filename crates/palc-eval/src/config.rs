@@ -186,10 +186,33 @@ pub struct Selection {
     pub example: ExampleConfig,
 }
 
+/// Parses TOML text; an error names the dotted path of the field it is in (e.g.
+/// `planning.standard_alc.time_headway_s`) besides the line and column that `toml` reports.
+fn from_toml<'de, T: Deserialize<'de>>(text: &'de str) -> Result<T, EvalError> {
+    let deserializer = toml::de::Deserializer::parse(text).map_err(|source| EvalError::Toml {
+        path: String::new(),
+        error: Box::new(source),
+    })?;
+    serde_path_to_error::deserialize(deserializer).map_err(|error| {
+        let path = error.path();
+        let known = path
+            .iter()
+            .any(|segment| !matches!(segment, serde_path_to_error::Segment::Unknown));
+        EvalError::Toml {
+            path: if known {
+                path.to_string()
+            } else {
+                String::new()
+            },
+            error: Box::new(error.into_inner()),
+        }
+    })
+}
+
 impl EvalConfig {
     /// Parses and checks the config text.
     pub fn from_toml_str(text: &str) -> Result<EvalConfig, EvalError> {
-        let config: EvalConfig = toml::from_str(text)?;
+        let config: EvalConfig = from_toml(text)?;
         config.validate()?;
         Ok(config)
     }
@@ -487,6 +510,39 @@ mod tests {
             error.contains("autobahn")
                 && error.contains("grid.speed_cases")
                 && error.contains("collector-high"),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn an_unknown_style_is_refused_naming_the_field_path() {
+        let error = EvalConfig::from_toml_str(&PROJECT_CONFIG.replace(
+            "styles = [\"aggressive\", \"neutral\", \"cautious\"]",
+            "styles = [\"reckless\"]",
+        ))
+        .unwrap_err();
+        assert!(
+            matches!(&error, EvalError::Toml { path, .. } if path == "grid.styles[0]"),
+            "{error:?}"
+        );
+        let error = error.to_string();
+        assert!(
+            error.contains("`grid.styles[0]`")
+                && error.contains("reckless")
+                && error.contains("line"),
+            "{error}"
+        );
+    }
+
+    #[test]
+    fn a_wrong_type_in_a_nested_field_names_its_path() {
+        let error = EvalConfig::from_toml_str(
+            &PROJECT_CONFIG.replace("spread_relative = 0.02", "spread_relative = \"2%\""),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            error.contains("`users[1].spread_relative`") && error.contains("line"),
             "{error}"
         );
     }

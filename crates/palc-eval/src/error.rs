@@ -30,9 +30,17 @@ pub enum EvalError {
         /// The error.
         source: Box<EvalError>,
     },
-    /// The TOML text could not be parsed (syntax, an unknown or missing field).
-    #[error("cannot parse the config: {0}")]
-    Toml(#[from] toml::de::Error),
+    /// The TOML text does not parse or does not match the schema (unknown field, missing
+    /// field, wrong type); the message names the field path, the line and the column.
+    #[error("cannot parse the config: {}{error}", at_field(path))]
+    Toml {
+        /// Dotted path of the field where the error is (e.g.
+        /// `planning.standard_alc.time_headway_s`); empty for a syntax error.
+        path: String,
+        /// The parse error, with its line and column (in the message, so not a `source`
+        /// that a report would print twice).
+        error: Box<toml::de::Error>,
+    },
     /// A config value is out of its bound.
     #[error("`{field}` is {value}, expected {bound}")]
     InvalidConfig {
@@ -104,5 +112,14 @@ impl EvalError {
             value: value.to_string(),
             bound: bound.into(),
         }
+    }
+}
+
+/// `` `path`: `` before a message, or nothing for an empty path.
+fn at_field(path: &str) -> String {
+    if path.is_empty() {
+        String::new()
+    } else {
+        format!("`{path}`: ")
     }
 }

@@ -201,6 +201,30 @@ impl Default for StoppingConfig {
     }
 }
 
+/// Parses TOML text; an error names the dotted path of the field it is in (e.g.
+/// `planning.standard_alc.time_headway_s`) besides the line and column that `toml` reports.
+fn from_toml<'de, T: Deserialize<'de>>(text: &'de str) -> Result<T, HarnessError> {
+    let deserializer =
+        toml::de::Deserializer::parse(text).map_err(|source| HarnessError::Toml {
+            path: String::new(),
+            error: Box::new(source),
+        })?;
+    serde_path_to_error::deserialize(deserializer).map_err(|error| {
+        let path = error.path();
+        let known = path
+            .iter()
+            .any(|segment| !matches!(segment, serde_path_to_error::Segment::Unknown));
+        HarnessError::Toml {
+            path: if known {
+                path.to_string()
+            } else {
+                String::new()
+            },
+            error: Box::new(error.into_inner()),
+        }
+    })
+}
+
 impl LearnConfig {
     /// This config for another cell of the test bed. Checked by
     /// [`LearnConfig::validate`] and when the run starts, like a parsed config.
@@ -223,7 +247,7 @@ impl LearnConfig {
 
     /// Parses and validates a TOML config.
     pub fn from_toml_str(text: &str) -> Result<LearnConfig, HarnessError> {
-        let config: LearnConfig = toml::from_str(text)?;
+        let config: LearnConfig = from_toml(text)?;
         config.validate()?;
         Ok(config)
     }

@@ -43,9 +43,17 @@ pub enum HarnessError {
         /// What does not hold.
         reason: String,
     },
-    /// The TOML config could not be read.
-    #[error("cannot parse the config: {0}")]
-    Toml(#[from] toml::de::Error),
+    /// The TOML text does not parse or does not match the schema (unknown field, missing
+    /// field, wrong type); the message names the field path, the line and the column.
+    #[error("cannot parse the config: {}{error}", at_field(path))]
+    Toml {
+        /// Dotted path of the field where the error is (e.g.
+        /// `planning.standard_alc.time_headway_s`); empty for a syntax error.
+        path: String,
+        /// The parse error, with its line and column (in the message, so not a `source`
+        /// that a report would print twice).
+        error: Box<toml::de::Error>,
+    },
     /// An error of the traffic simulation.
     #[error(transparent)]
     Traffic(#[from] palc_traffic::SceneError),
@@ -61,4 +69,13 @@ pub enum HarnessError {
     /// An error of the aggregator.
     #[error(transparent)]
     Aggregator(#[from] palc_aggregator::AggregatorError),
+}
+
+/// `` `path`: `` before a message, or nothing for an empty path.
+fn at_field(path: &str) -> String {
+    if path.is_empty() {
+        String::new()
+    } else {
+        format!("`{path}`: ")
+    }
 }

@@ -108,6 +108,22 @@ fn a_user_with_spread_is_judged_against_the_nominal_ceiling() {
 }
 
 #[test]
+fn a_wrong_type_in_a_nested_field_names_its_path_and_line() {
+    let text = include_str!("../../../configs/learn.toml");
+    let text = text.replacen("time_headway_s = 1.0", "time_headway_s = \"1 s\"", 1);
+    let err = LearnConfig::from_toml_str(&text).unwrap_err().to_string();
+    assert!(
+        err.contains("`planning.standard_alc.time_headway_s`")
+            && err.contains("line 25")
+            && err.contains("invalid type"),
+        "{err}"
+    );
+    let text = include_str!("../../../configs/learn.toml").replacen("lanes = 2", "lanes = -2", 1);
+    let err = LearnConfig::from_toml_str(&text).unwrap_err().to_string();
+    assert!(err.contains("`traffic.road.lanes`"), "{err}");
+}
+
+#[test]
 fn invalid_configs_are_refused_naming_the_field() {
     let mut bad = config(Method::Palc, "neutral");
     bad.planning.takeover_threshold_m = -0.3;

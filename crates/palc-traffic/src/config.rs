@@ -9,6 +9,31 @@ use crate::idm::{DesiredGap, IdmParams};
 use crate::road::Road;
 use serde::{Deserialize, Serialize};
 
+/// Parses TOML text; an error names the dotted path of the field it is in (e.g.
+/// `road.lanes`) besides the line and column that `toml` reports.
+fn from_toml<'de, T: Deserialize<'de>>(text: &'de str) -> Result<T, ConfigError> {
+    let deserializer = toml::de::Deserializer::parse(text).map_err(|source| ConfigError::Toml {
+        path: String::new(),
+        error: Box::new(source),
+    })?;
+    serde_path_to_error::deserialize(deserializer).map_err(|error| ConfigError::Toml {
+        path: field_path(error.path()),
+        error: Box::new(error.into_inner()),
+    })
+}
+
+/// The dotted path of a field (`a.b[2].c`), or an empty string when nothing of it is known.
+pub(crate) fn field_path(path: &serde_path_to_error::Path) -> String {
+    if path
+        .iter()
+        .all(|segment| matches!(segment, serde_path_to_error::Segment::Unknown))
+    {
+        String::new()
+    } else {
+        path.to_string()
+    }
+}
+
 /// Largest plausible road speed in a config (mph); bigger values are most likely km/h.
 pub const MAX_SPEED_MPH: f64 = 100.0;
 
@@ -230,7 +255,7 @@ pub struct ProfilePointConfig {
 impl ScenarioConfig {
     /// Parses a TOML config and validates the parts that do not depend on a grid cell.
     pub fn from_toml_str(text: &str) -> Result<ScenarioConfig, ConfigError> {
-        let config: ScenarioConfig = toml::from_str(text)?;
+        let config: ScenarioConfig = from_toml(text)?;
         config.validate()?;
         Ok(config)
     }

@@ -9,9 +9,16 @@ use crate::vehicle::VehicleId;
 #[non_exhaustive]
 pub enum ConfigError {
     /// The TOML text does not parse or does not match the schema (unknown field, missing
-    /// field, wrong type); the message names the field and the line.
-    #[error("invalid scenario config: {0}")]
-    Toml(#[from] toml::de::Error),
+    /// field, wrong type); the message names the field path, the line and the column.
+    #[error("invalid scenario config: {}{error}", at_field(path))]
+    Toml {
+        /// Dotted path of the field where the error is (e.g. `road.lanes`, `platoon.leader_profile[2].time_s`);
+        /// empty for a syntax error, which has no field.
+        path: String,
+        /// The parse error, with its line and column (in the message, so not a `source`
+        /// that a report would print twice).
+        error: Box<toml::de::Error>,
+    },
     /// A number lies outside the range it must lie in (negative length, speed in wrong units).
     #[error("`{field}` = {value:?} is out of range: it must be {bound}")]
     OutOfRange {
@@ -161,4 +168,13 @@ pub enum SceneError {
         /// Largest horizon allowed.
         max: usize,
     },
+}
+
+/// `` `path`: `` before a message, or nothing for an empty path.
+pub(crate) fn at_field(path: &str) -> String {
+    if path.is_empty() {
+        String::new()
+    } else {
+        format!("`{path}`: ")
+    }
 }

@@ -299,3 +299,36 @@ fn cells_out_of_the_grid_and_bad_cells_are_refused() {
         Err(ConfigError::NotATestbed)
     ));
 }
+
+#[test]
+fn a_wrong_type_in_a_nested_field_names_its_path_line_and_column() {
+    let text = PLATOON.replace(
+        "{ time_s = 10.0, speed_mph = 0.0 }",
+        "{ time_s = 10.0, speed_mph = \"fast\" }",
+    );
+    let error = ScenarioConfig::from_toml_str(&text).unwrap_err();
+    assert!(
+        matches!(error, ConfigError::Toml { ref path, .. } if path == "platoon.leader_profile[1].speed_mph"),
+        "{error:?}"
+    );
+    check(
+        &text,
+        &[
+            "`platoon.leader_profile[1].speed_mph`",
+            "line 11",
+            "invalid type",
+        ],
+    );
+    let text = format!("[road]\nlanes = 2.5\n{TESTBED}");
+    check(&text, &["`road.lanes`", "line"]);
+}
+
+#[test]
+fn a_syntax_error_has_no_field_path_but_a_line() {
+    let error = ScenarioConfig::from_toml_str("[road\nlanes = 2").unwrap_err();
+    assert!(
+        matches!(error, ConfigError::Toml { ref path, .. } if path.is_empty()),
+        "{error:?}"
+    );
+    assert!(error.to_string().contains("line 1"), "{error}");
+}

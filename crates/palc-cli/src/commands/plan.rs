@@ -81,7 +81,7 @@ fn refusal_status(error: &PlanError) -> &'static str {
 pub fn run(args: PlanArgs) -> anyhow::Result<()> {
     let path = &args.problem;
     let file = File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
-    let input: PlanInput = serde_json::from_reader(BufReader::new(file))
+    let input: PlanInput = crate::parse::json(BufReader::new(file))
         .with_context(|| format!("cannot read the plan problem in {}", path.display()))?;
     let result = Planner::new(input.config).and_then(|mut planner| planner.plan(&input.problem));
     let output = match &result {

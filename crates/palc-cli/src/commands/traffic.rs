@@ -56,7 +56,8 @@ enum Format {
     Json,
 }
 
-/// Largest number of steps one run may write, so that a typo cannot fill the disk.
+/// Largest number of steps one run may write (`--duration / --dt`), so that a typo cannot
+/// fill the disk or the memory (a row per vehicle and step is held until the file is written).
 const MAX_STEPS: f64 = 1e6;
 
 pub fn run(args: TrafficArgs) -> anyhow::Result<()> {

@@ -25,6 +25,7 @@ use palc_zone_filter::{Discriminant, FeatureSet, Label, Sample, ZoneConfig, Zone
 use serde::Serialize;
 
 use crate::console::{self, warning};
+use crate::parse;
 
 /// The perceived safe zone filter (GDA, paper Eqs. 1-8).
 #[derive(Debug, Args)]
@@ -94,7 +95,7 @@ fn fit(args: &FitArgs) -> anyhow::Result<()> {
         Some(path) => {
             let text = std::fs::read_to_string(path)
                 .with_context(|| format!("cannot read config {}", path.display()))?;
-            let config = toml::from_str::<ZoneConfig>(&text)
+            let config = parse::toml::<ZoneConfig>(&text)
                 .with_context(|| format!("in {}", path.display()))?;
             config
                 .validate()
@@ -136,7 +137,7 @@ fn fit(args: &FitArgs) -> anyhow::Result<()> {
 fn classify(args: &ClassifyArgs) -> anyhow::Result<()> {
     let file =
         File::open(&args.model).with_context(|| format!("cannot open {}", args.model.display()))?;
-    let model: ZoneModel = serde_json::from_reader(BufReader::new(file))
+    let model: ZoneModel = parse::json(BufReader::new(file))
         .with_context(|| format!("in model {}", args.model.display()))?;
     let set = model.config().feature_set;
     let rows = read_points(&args.points, set)?;
@@ -190,7 +191,7 @@ fn open(path: &Path) -> anyhow::Result<BufReader<File>> {
 fn read_samples(path: &Path, set: FeatureSet) -> anyhow::Result<Vec<Sample>> {
     let reader = open(path)?;
     if is_json(path) {
-        serde_json::from_reader(reader).with_context(|| format!("in {}", path.display()))
+        parse::json(reader).with_context(|| format!("in {}", path.display()))
     } else {
         samples_from_csv(reader, set).with_context(|| format!("in {}", path.display()))
     }
@@ -200,7 +201,7 @@ fn read_points(path: &Path, set: FeatureSet) -> anyhow::Result<Vec<f64>> {
     let reader = open(path)?;
     if is_json(path) {
         let points: Vec<Vec<f64>> =
-            serde_json::from_reader(reader).with_context(|| format!("in {}", path.display()))?;
+            parse::json(reader).with_context(|| format!("in {}", path.display()))?;
         let d = set.dimension();
         if let Some((i, p)) = points.iter().enumerate().find(|(_, p)| p.len() != d) {
             bail!(
@@ -226,11 +227,51 @@ pub(crate) fn samples_from_csv(reader: impl Read, set: FeatureSet) -> anyhow::Re
         .collect()
 }
 
+/// Largest number of data rows read from a samples or points CSV.
+///
+/// A samples file holds the labelled lane changes of one user (a few hundred at
+/// most in the paper's set-up) and a points file what is to be classified; ten
+/// million rows are far beyond either, and bound the memory of the rows read (about
+/// 100 bytes each, 1 GB at the bound) before a typo or a wrong file can exhaust it.
+/// A longer file is refused with [`TooManyRows`], read to its end only to count.
+pub const MAX_CSV_ROWS: usize = 10_000_000;
+
+/// A CSV with more data rows than a bound ([`MAX_CSV_ROWS`]); the caller names the file.
+#[derive(Debug, PartialEq)]
+pub struct TooManyRows {
+    /// Data rows in the file (the header not counted).
+    pub rows: u64,
+    /// The bound.
+    pub max: usize,
+}
+
+impl std::fmt::Display for TooManyRows {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} data rows, more than the {} rows (MAX_CSV_ROWS) that are read; split the file",
+            self.rows, self.max
+        )
+    }
+}
+
+impl std::error::Error for TooManyRows {}
+
 /// Reads the feature columns of `set` (by name) and, if `with_label`, the `y` column.
-fn csv_rows(
+pub(crate) fn csv_rows(
     reader: impl Read,
     set: FeatureSet,
     with_label: bool,
+) -> anyhow::Result<Vec<(Vec<f64>, Option<Label>)>> {
+    csv_rows_at_most(reader, set, with_label, MAX_CSV_ROWS)
+}
+
+/// [`csv_rows`] with the bound on the number of rows as a parameter.
+fn csv_rows_at_most(
+    reader: impl Read,
+    set: FeatureSet,
+    with_label: bool,
+    max_rows: usize,
 ) -> anyhow::Result<Vec<(Vec<f64>, Option<Label>)>> {
     let mut csv = csv::ReaderBuilder::new()
         .trim(csv::Trim::All)
@@ -263,7 +304,17 @@ fn csv_rows(
         .collect::<anyhow::Result<Vec<_>>>()?;
     let label_column = if with_label { Some(column("y")?) } else { None };
     let mut rows = Vec::new();
-    for record in csv.records() {
+    let mut records = csv.records();
+    while let Some(record) = records.next() {
+        if rows.len() == max_rows {
+            // Count the rest without keeping it (or failing on it) for the message.
+            let rest = records.count() as u64;
+            return Err(TooManyRows {
+                rows: max_rows as u64 + 1 + rest,
+                max: max_rows,
+            }
+            .into());
+        }
         let record = record.context("cannot read a CSV record")?;
         // csv counts lines from 1, the header being line 1.
         let line = record.position().map_or(0, |p| p.line());
@@ -308,6 +359,36 @@ mod tests {
     const EXAMPLE_SAMPLES: &str = include_str!("../../../../configs/examples/zone-samples.csv");
     const EXAMPLE_POINTS: &str = include_str!("../../../../configs/examples/zone-points.csv");
     const EXAMPLE_CONFIG: &str = include_str!("../../../../configs/examples/zone.toml");
+
+    #[test]
+    fn a_csv_longer_than_the_bound_is_refused_naming_the_bound_and_the_count() {
+        for (example, with_label) in [(EXAMPLE_SAMPLES, true), (EXAMPLE_POINTS, false)] {
+            let rows = example
+                .lines()
+                .skip(1)
+                .filter(|l| !l.trim().is_empty())
+                .count();
+            assert!(rows > 3, "the example has {rows} rows");
+            let error =
+                csv_rows_at_most(example.as_bytes(), FeatureSet::Paper, with_label, 3).unwrap_err();
+            assert_eq!(
+                error.downcast_ref::<TooManyRows>(),
+                Some(&TooManyRows {
+                    rows: rows as u64,
+                    max: 3
+                })
+            );
+            let message = error.to_string();
+            assert!(
+                message.contains(&format!("{rows} data rows")) && message.contains("3 rows"),
+                "{message}"
+            );
+            // At the bound, the file is read.
+            let read =
+                csv_rows_at_most(example.as_bytes(), FeatureSet::Paper, with_label, rows).unwrap();
+            assert_eq!(read.len(), rows);
+        }
+    }
 
     #[test]
     fn the_example_files_fit_and_classify() {
