@@ -254,16 +254,7 @@ pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> Result<(), EvalEr
             min_gap_preceding_m: row.min_of(|s| s.min_gap_preceding_m),
             min_gap_target_lead_m: row.min_of(|s| s.min_gap_target_lead_m),
             min_gap_target_lag_m: row.min_of(|s| s.min_gap_target_lag_m),
-            min_ttc_s: row.min_of(|s| {
-                [
-                    s.min_ttc_preceding_s,
-                    s.min_ttc_target_lead_s,
-                    s.min_ttc_target_lag_s,
-                ]
-                .into_iter()
-                .flatten()
-                .min_by(f64::total_cmp)
-            }),
+            min_ttc_s: row.min_of(SafetyMetrics::min_ttc_s),
             note,
         })?;
     }

@@ -60,16 +60,7 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
                 distribution(&|s| s.min_gap_preceding_m),
                 distribution(&|s| s.min_gap_target_lead_m),
                 distribution(&|s| s.min_gap_target_lag_m),
-                distribution(&|s| {
-                    [
-                        s.min_ttc_preceding_s,
-                        s.min_ttc_target_lead_s,
-                        s.min_ttc_target_lag_s,
-                    ]
-                    .into_iter()
-                    .flatten()
-                    .min_by(f64::total_cmp)
-                }),
+                distribution(&SafetyMetrics::min_ttc_s),
             );
         }
     }

@@ -187,6 +187,18 @@ impl SafetyMetrics {
     pub fn is_safe(&self) -> bool {
         !self.collision && self.rss_violations == 0
     }
+
+    /// The smallest time to collision with any of the three vehicles (s).
+    pub fn min_ttc_s(&self) -> Option<f64> {
+        [
+            self.min_ttc_preceding_s,
+            self.min_ttc_target_lead_s,
+            self.min_ttc_target_lag_s,
+        ]
+        .into_iter()
+        .flatten()
+        .min_by(f64::total_cmp)
+    }
 }
 
 /// Measures the safety of one lane change, one scene step at a time.
