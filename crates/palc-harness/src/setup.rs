@@ -64,6 +64,7 @@ impl Default for PlanningConfig {
                 time_headway_s: 1.0,
                 lane_change_duration_s: 3.5,
                 min_lead_gap_s: 0.8,
+                min_lag_gap_s: 0.0,
             },
             standard_alc_min_delay_s: 0.5,
             target_l: 3.5,
@@ -217,6 +218,7 @@ impl Setup {
         let mut preceding = Vec::with_capacity(window + 1);
         let mut adjacent = Vec::with_capacity(window + 1);
         let mut lane_keeping = Vec::with_capacity(window + 1);
+        let mut seeking = false;
         for step in 0..=window {
             situations.push(situation(&rollout));
             lane_keeping.push(
@@ -232,8 +234,12 @@ impl Setup {
                 rollout.adjacent().map(|v| (v.state.s, v.state.l)),
                 origin_s,
             ));
+            // The ego seeks a gap once it is as close to the preceding vehicle as
+            // the standard ALC's start headway, so that every user (whose headway
+            // is longer) has decided to change lanes; the search then goes on.
+            seeking |= situations[step].decides_at(config.standard_alc.time_headway_s);
             if step < window {
-                lane_keeping_step(&mut rollout, config, set_speed, true)?;
+                lane_keeping_step(&mut rollout, config, set_speed, seeking)?;
             }
         }
 
@@ -371,8 +377,8 @@ fn target_gaps_safe(situation: &Situation, safety: &SafetyConfig) -> bool {
     lead_ok && lag_ok
 }
 
-/// One simulation step with the ego keeping its lane under its ACC; after the
-/// trigger (`seeking_gap`), the ego also drops back while the gap beside it is unsafe.
+/// One simulation step with the ego keeping its lane under its ACC; when
+/// `seeking_gap`, the ego also drops back while the gap beside it is unsafe.
 fn lane_keeping_step(
     scene: &mut Scene,
     config: &PlanningConfig,
@@ -381,10 +387,12 @@ fn lane_keeping_step(
 ) -> Result<(), HarnessError> {
     let ego = scene.ego().map(|e| e.state).unwrap_or_default();
     let mut acceleration = config.acc.acceleration(ego.v, set_speed, acc_leader(scene));
-    // Gap seeking: while the gap beside is not safe, drop back below the target
-    // lane's speed so that the next gap comes alongside.
+    // Gap seeking: while the gap beside is neither acceptable to the standard ALC
+    // nor safe, drop back below the target lane's speed so that the next gap
+    // comes alongside.
     let seen = situation(scene);
-    if seeking_gap && config.acc.enabled && !target_gaps_safe(&seen, &config.safety) {
+    let acceptable = config.standard_alc.accepts(&seen) && target_gaps_safe(&seen, &config.safety);
+    if seeking_gap && config.acc.enabled && !acceptable {
         let flow = [seen.target_lead_speed, seen.target_lag_speed]
             .into_iter()
             .flatten()

@@ -29,6 +29,11 @@ pub struct Style {
     /// paper's congestion levels matter (see docs/paper-mapping.md).
     #[serde(default = "Style::default_min_lead_gap_s")]
     pub min_lead_gap_s: f64,
+    /// Smallest net gap to the follower on the target lane that the user accepts,
+    /// as a time gap at the follower's speed (s); 0 (the default, and the paper's
+    /// styles) accepts any positive gap.
+    #[serde(default)]
+    pub min_lag_gap_s: f64,
 }
 
 impl Style {
@@ -37,18 +42,21 @@ impl Style {
         time_headway_s: 1.15,
         lane_change_duration_s: 1.7,
         min_lead_gap_s: 0.5,
+        min_lag_gap_s: 0.0,
     };
     /// Neutral: 1.23 s headway, 2.1 s lane change (paper, Section III.A).
     pub const NEUTRAL: Style = Style {
         time_headway_s: 1.23,
         lane_change_duration_s: 2.1,
         min_lead_gap_s: 0.6,
+        min_lag_gap_s: 0.0,
     };
     /// Cautious: 1.76 s headway, 2.5 s lane change (paper, Section III.A).
     pub const CAUTIOUS: Style = Style {
         time_headway_s: 1.76,
         lane_change_duration_s: 2.5,
         min_lead_gap_s: 0.8,
+        min_lag_gap_s: 0.0,
     };
 
     fn default_min_lead_gap_s() -> f64 {
@@ -70,6 +78,13 @@ impl Style {
                     bound: "a finite value > 0".to_owned(),
                 });
             }
+        }
+        if !(self.min_lag_gap_s.is_finite() && (0.0..=10.0).contains(&self.min_lag_gap_s)) {
+            return Err(HarnessError::InvalidConfig {
+                field: format!("{field}.min_lag_gap_s"),
+                value: self.min_lag_gap_s,
+                bound: "a value in [0, 10.0]".to_owned(),
+            });
         }
         Ok(())
     }
@@ -172,22 +187,47 @@ pub struct Situation {
     pub target_lag_speed: Option<f64>,
 }
 
+impl Situation {
+    /// Whether the time headway to the preceding vehicle is positive and at most
+    /// `time_headway_s`.
+    pub fn decides_at(&self, time_headway_s: f64) -> bool {
+        self.time_headway_s > 0.0 && self.time_headway_s <= time_headway_s
+    }
+}
+
 impl Style {
-    /// Whether the user would start the lane change in this situation.
+    /// Whether the user, having decided to change lanes, finds the gaps in this
+    /// situation acceptable: the lead gap at least `min_lead_gap_s` at the ego's
+    /// speed, the lag gap positive and at least `min_lag_gap_s` at the follower's
+    /// speed, and the ego
+    /// still behind the preceding vehicle (nobody starts behind a vehicle it has
+    /// already reached).
     pub fn accepts(&self, situation: &Situation) -> bool {
         let lead_ok = situation
             .target_lead_gap_m
             .is_none_or(|gap| gap >= self.min_lead_gap_s * situation.ego_speed);
-        // Nobody starts a lane change into a vehicle alongside.
-        let lag_ok = situation.target_lag_gap_m.is_none_or(|gap| gap > 0.0);
-        // Nor behind a preceding vehicle it has already reached.
-        let behind = situation.time_headway_s > 0.0;
-        behind && situation.time_headway_s <= self.time_headway_s && lead_ok && lag_ok
+        let lag_ok = situation.target_lag_gap_m.is_none_or(|gap| {
+            gap > 0.0 && gap >= self.min_lag_gap_s * situation.target_lag_speed.unwrap_or(0.0)
+        });
+        situation.time_headway_s > 0.0 && lead_ok && lag_ok
     }
 
-    /// The first step at which the user starts, given the situation per step.
+    /// Whether the time headway to the preceding vehicle has fallen to the user's.
+    pub fn decides(&self, situation: &Situation) -> bool {
+        situation.decides_at(self.time_headway_s)
+    }
+
+    /// The step at which the user starts, given the situation per step: the user
+    /// decides to change lanes at the first step where the headway has fallen to
+    /// theirs, then starts at the first step from there where the gaps are
+    /// acceptable. (An ego that drops back to seek a gap opens the headway again;
+    /// the decision stands.)
     pub fn start_step(&self, situations: &[Situation]) -> Option<usize> {
-        situations.iter().position(|s| self.accepts(s))
+        let decided = situations.iter().position(|s| self.decides(s))?;
+        situations[decided..]
+            .iter()
+            .position(|s| self.accepts(s))
+            .map(|offset| decided + offset)
     }
 }
 
@@ -369,6 +409,36 @@ mod tests {
         assert_eq!(style.start_step(&situations), Some(3));
         assert_eq!(style.start_step(&situations[..3]), None);
         assert_eq!(style.start_step(&[at(1.0, None)]), Some(0));
+    }
+
+    #[test]
+    fn a_user_decides_on_the_headway_then_waits_for_the_gap() {
+        let style = Style {
+            min_lag_gap_s: 0.5,
+            ..Style::NEUTRAL
+        };
+        let at = |headway: f64, lag: f64| Situation {
+            time_headway_s: headway,
+            target_lead_gap_m: Some(50.0),
+            target_lag_gap_m: Some(lag),
+            ego_speed: 20.0,
+            target_lead_speed: Some(20.0),
+            target_lag_speed: Some(20.0),
+        };
+        // Decides at step 1 (1.2 s <= 1.23 s); the lag gap (10 m needed) opens at
+        // step 3, when an ego dropping back has opened the headway again.
+        let situations = [at(1.5, 20.0), at(1.2, 5.0), at(1.3, 8.0), at(1.6, 12.0)];
+        assert_eq!(style.start_step(&situations), Some(3));
+        // A gap before the decision does not count.
+        assert_eq!(style.start_step(&situations[..1]), None);
+        // Nobody starts behind a vehicle it has reached.
+        assert_eq!(style.start_step(&[at(-0.5, 20.0)]), None);
+        let bad = Style {
+            min_lag_gap_s: f64::NAN,
+            ..Style::NEUTRAL
+        };
+        let err = bad.validate("user.custom").unwrap_err().to_string();
+        assert!(err.contains("user.custom.min_lag_gap_s"), "{err}");
     }
 
     #[test]

@@ -58,3 +58,38 @@ fn labels_follow_who_drove() {
     assert_eq!(label(Method::Palc, Driver::User), Some(true));
     assert_eq!(label(Method::Palc, Driver::Rejected), Some(false));
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// In any scene of the test bed, with the ego holding its speed (the paper's
+    /// set-up) or under its ACC, no user's expected lane change and not the standard
+    /// ALC's starts behind a vehicle the ego has already reached.
+    #[test]
+    fn no_lane_change_starts_behind_a_negative_gap(
+        case in 0usize..4,
+        headway in 20.0f64..60.0,
+        seed in 1u64..1000,
+        acc in any::<bool>(),
+    ) {
+        let text = include_str!("../../../configs/learn.toml");
+        let mut config = LearnConfig::from_toml_str(text).unwrap();
+        let speed_case = ["collector-high", "collector-slow", "arterial-high", "arterial-slow"][case];
+        config = config.with_cell(palc_harness::CellChoice {
+            speed_case: speed_case.to_owned(),
+            headway_m: headway,
+            seed,
+        });
+        config.planning.acc.enabled = acc;
+        // A scene the set-up refuses (no start within the window) has nothing to check.
+        let Ok(setup) = prepare(&config) else { return Ok(()); };
+        let standard = setup.standard_start_step;
+        prop_assert!(setup.situations[standard].time_headway_s > 0.0);
+        for preset in palc_harness::StylePreset::ALL {
+            if let Some(expected) = setup.expected(&preset.style()) {
+                let start = (expected.start_s / setup.dt).round() as usize;
+                prop_assert!(setup.situations[start].time_headway_s > 0.0, "{preset}: {start}");
+            }
+        }
+    }
+}

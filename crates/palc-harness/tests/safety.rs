@@ -213,3 +213,45 @@ fn safety_metrics_round_trip_through_json() {
     let back: SafetyMetrics = serde_json::from_str(&text).unwrap();
     assert_eq!(back, metrics);
 }
+
+#[test]
+fn with_the_safety_layer_on_no_driven_plan_is_unsafe_and_every_refusal_is_recorded() {
+    use palc_harness::{LearnConfig, LearningLoop, Method, NoObserver, Observer, Violation};
+
+    #[derive(Default)]
+    struct Refusals(Vec<(usize, Violation)>);
+    impl Observer for Refusals {
+        fn safety_refusal(&mut self, lane_change: usize, violation: &Violation) {
+            self.0.push((lane_change, *violation));
+        }
+    }
+
+    let text = include_str!("../../../configs/learn-safe.toml");
+    let base = LearnConfig::from_toml_str(text).expect("the safe config parses");
+    assert!(base.planning.acc.enabled && base.planning.safety.enforce);
+    let mut seen = 0;
+    for method in [Method::Palc, Method::Paper] {
+        let config = base.clone().with_method(method);
+        let mut run = LearningLoop::new(&config, None).expect("the default cell runs");
+        let mut observer = Refusals::default();
+        while run.termination().is_none() {
+            run.step(&mut observer).expect("a lane change");
+        }
+        for record in run.records() {
+            assert!(record.safety.is_safe(), "{method:?} {:?}", record.safety);
+            assert!(record.planned_safety.is_safe(), "{method:?}");
+        }
+        let recorded: Vec<(usize, Violation)> = run
+            .records()
+            .iter()
+            .filter_map(|r| r.safety_refusal.map(|v| (r.index, v)))
+            .collect();
+        assert_eq!(recorded, observer.0);
+        for (_, violation) in &recorded {
+            assert!(violation.gap_m < violation.safe_distance_m);
+        }
+        seen += run.records().len();
+    }
+    assert!(seen > 0);
+    let _ = NoObserver;
+}
