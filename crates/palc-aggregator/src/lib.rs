@@ -77,7 +77,12 @@ mod rows;
 mod scale;
 mod step;
 
-pub use convex::{ConvexSet, DIAGONAL_ZERO_RATIO, SCHUR_MARGIN, project_convex};
+pub use convex::{ConvexSet, project_convex};
+
+/// Tuning constants of the convex projection, for tests and for those who study it.
+pub mod advanced {
+    pub use crate::convex::{DIAGONAL_ZERO_RATIO, SCHUR_MARGIN};
+}
 pub use correction::{
     ApprenticeshipRule, ApprenticeshipState, CorrectionInput, CorrectionOutcome, CorrectionRule,
     IncrementalRule, RewardCorrection,

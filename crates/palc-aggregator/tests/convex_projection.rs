@@ -1,9 +1,8 @@
 //! Property tests of the projection onto the convex set, checked by the planner's
 //! own convexity test.
 
-use palc_aggregator::{
-    ConvexSet, DIAGONAL_ZERO_RATIO, LearnableRows, project_convex, resample_weights,
-};
+use palc_aggregator::advanced::DIAGONAL_ZERO_RATIO;
+use palc_aggregator::{ConvexSet, LearnableRows, project_convex, resample_weights};
 use palc_planner::{FEATURE_COUNT, Weights, check_convexity};
 use proptest::prelude::*;
 

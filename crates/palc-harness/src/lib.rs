@@ -45,16 +45,15 @@ mod setup;
 mod standard_alc;
 pub mod user;
 
-pub use acc::{AccConfig, acc_leader};
+pub use acc::AccConfig;
 pub use config::{
     CellChoice, LearnConfig, MAX_LANE_CHANGES, MAX_SUCCESS_STREAK, MAX_TAKEOVERS, StoppingConfig,
     UserConfig, UserStyle,
 };
-pub use drive::{Drive, execute, plan_safety, problem};
 pub use error::HarnessError;
 pub use learn::{RunResult, aggregator_options, prepare, run};
 pub use learning_loop::LearningLoop;
-pub use method::{Driver, Method, label};
+pub use method::Method;
 pub use observer::{LessonEvent, NoObserver, Observer};
 pub use palc_aggregator::Timings;
 pub use record::{LaneChangeRecord, Outcome, RunSummary, Takeover};
@@ -62,3 +61,13 @@ pub use safety::{SafetyConfig, SafetyMetrics, SafetyMonitor, Violation};
 pub use setup::{PlanningConfig, Setup};
 pub use standard_alc::StandardWeights;
 pub use user::StylePreset;
+
+/// The loop's building blocks, for those who drive their own loop or test one
+/// part of it: the planning problem of a scenario, the execution of a plan with a
+/// user, the safety check of a plan, the ego's ACC leader and the lesson labels.
+/// [`LearningLoop`] composes them; most embedders need only that.
+pub mod advanced {
+    pub use crate::acc::acc_leader;
+    pub use crate::drive::{Drive, execute, plan_safety, problem};
+    pub use crate::method::{Driver, label};
+}

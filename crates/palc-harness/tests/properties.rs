@@ -1,7 +1,8 @@
 //! Property tests of the harness: perceived safety ratio and labelling.
 
+use palc_harness::advanced::{Driver, execute, label, problem};
 use palc_harness::user::{ExpectedLaneChange, first_takeover};
-use palc_harness::{Driver, LearnConfig, Method, execute, label, prepare, problem};
+use palc_harness::{LearnConfig, Method, prepare};
 use palc_planner::{Planner, PlannerConfig, Weights};
 use proptest::prelude::*;
 

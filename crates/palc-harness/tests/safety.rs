@@ -2,7 +2,8 @@
 //! leader the ACC must not hit, a lag vehicle closing on a lane change that the
 //! measures must flag, and the record's new fields through JSON.
 
-use palc_harness::{AccConfig, SafetyConfig, SafetyMetrics, SafetyMonitor, acc_leader};
+use palc_harness::advanced::acc_leader;
+use palc_harness::{AccConfig, SafetyConfig, SafetyMetrics, SafetyMonitor};
 use palc_traffic::{
     Driver, EgoState, IdmParams, Lane, Road, Scene, SpeedProfile, Vehicle, VehicleId, VehicleState,
     ballistic_step,
