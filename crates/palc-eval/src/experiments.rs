@@ -7,6 +7,7 @@ use palc_harness::Method;
 use crate::EvalError;
 use crate::figures::{self, Bars, Example, Lines};
 use crate::harness_runs::ExampleTrace;
+use crate::plan::Experiment;
 use crate::results::{PART_NAMES, RunRow};
 use crate::stats;
 use crate::views::{FigureFile, grid, slug, speed_label, timing, with_transfer};
@@ -41,6 +42,30 @@ fn means_by(
         })
         .collect();
     (categories, series)
+}
+
+/// The smallest of the three gaps of `safety` (m), if any was measured.
+fn smallest_gap(safety: &palc_harness::SafetyMetrics) -> Option<f64> {
+    [
+        safety.min_gap_preceding_m,
+        safety.min_gap_target_lead_m,
+        safety.min_gap_target_lag_m,
+    ]
+    .into_iter()
+    .flatten()
+    .min_by(f64::total_cmp)
+}
+
+/// The empirical distribution function of `values` as points `(value, fraction at or
+/// below)`, thinned to at most 200 points.
+fn empirical_cdf(mut values: Vec<f64>) -> Vec<(f64, f64)> {
+    values.sort_by(f64::total_cmp);
+    let n = values.len();
+    let stride = n.div_ceil(200).max(1);
+    (0..n)
+        .filter(|i| i % stride == 0 || i + 1 == n)
+        .map(|i| (values[i], (i + 1) as f64 / n as f64))
+        .collect()
 }
 
 /// Draws every figure into `dir`.
@@ -190,6 +215,32 @@ pub fn draw_all(
             &|dir, stem| figures::save(dir, stem, (900, 450), &safety).map(|_| ()),
         )?;
     }
+    let gaps = Lines {
+        title: "Smallest net gap per lane change, system-driven steps (grid)".into(),
+        x_desc: "smallest net gap to the preceding, lead or lag vehicle (m; < 0: overlap)".into(),
+        y_desc: "fraction of lane changes at or below (-)".into(),
+        series: methods
+            .iter()
+            .map(|&m| {
+                let values = rows
+                    .iter()
+                    .filter(|r| r.spec.experiment == Experiment::Grid && r.spec.method == m)
+                    .flat_map(|r| &r.iterations)
+                    .filter_map(|i| smallest_gap(&i.safety));
+                (m.name().to_owned(), empirical_cdf(values.collect()))
+            })
+            .filter(|(_, points)| !points.is_empty())
+            .collect(),
+        y_range: Some((0.0, 1.05)),
+        log_y: false,
+    };
+    if !gaps.series.is_empty() {
+        save(
+            "fig14-safety-gaps".into(),
+            "Fig. 14 (not in the paper): distribution of the smallest net gap of each grid lane change to the preceding vehicle and the target lane's lead and lag, over the steps the system drove; a gap below 0 is a collision (REPORT.md, safety section)".into(),
+            &|dir, stem| figures::save(dir, stem, (900, 450), &gaps).map(|_| ()),
+        )?;
+    }
     let mut series = Vec::new();
     for &method in methods {
         let timed = timing(rows, method);
@@ -257,4 +308,23 @@ pub fn draw_all(
         )?;
     }
     Ok(files)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_empirical_cdf_rises_to_one_in_sorted_order() {
+        assert!(empirical_cdf(Vec::new()).is_empty());
+        let points = empirical_cdf(vec![3.0, -1.0, 2.0, 2.0]);
+        assert_eq!(
+            points,
+            vec![(-1.0, 0.25), (2.0, 0.5), (2.0, 0.75), (3.0, 1.0)]
+        );
+        let many = empirical_cdf((0..1000).map(f64::from).collect());
+        assert!(many.len() <= 201);
+        assert_eq!(many.last(), Some(&(999.0, 1.0)));
+        assert!(many.windows(2).all(|w| w[0].0 <= w[1].0 && w[0].1 < w[1].1));
+    }
 }

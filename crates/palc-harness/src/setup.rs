@@ -263,17 +263,32 @@ impl Setup {
         let delay = (config.standard_alc_min_delay_s / config.dt).ceil() as usize;
         let duration = (standard.lane_change_duration_s / config.dt).ceil() as usize;
         let earliest = own_start.max(latest_user + delay);
+        // Nobody, the system included, starts behind a vehicle it has reached.
+        let behind = |start: usize| situations[start].time_headway_s > 0.0;
         let standard_start_step = (earliest..=window.saturating_sub(duration))
             .find(|&start| {
-                !config.safety.enforce
-                    || situations[start..=start + duration]
-                        .iter()
-                        .all(|s| target_gaps_safe(s, &config.safety))
+                behind(start)
+                    && (!config.safety.enforce
+                        || situations[start..=start + duration]
+                            .iter()
+                            .all(|s| target_gaps_safe(s, &config.safety)))
             })
             .ok_or_else(|| {
+                let reason = if config.safety.enforce {
+                    "the target-lane gaps stay below the safe distance".to_owned()
+                } else {
+                    format!(
+                        "the ego has reached the preceding vehicle (time headway {:.2} s) when \
+                         the standard ALC would start, {} steps after the latest user",
+                        situations
+                            .get(earliest)
+                            .map_or(f64::NAN, |s| s.time_headway_s),
+                        delay
+                    )
+                };
                 scenario_error(format!(
-                    "no safe lane change: the target-lane gaps stay below the safe distance \
-                     for the standard ALC's {} s lane change within the {} s search window",
+                    "no safe lane change for the standard ALC's {} s lane change within the \
+                     {} s search window: {reason}",
                     standard.lane_change_duration_s, config.search_window_s
                 ))
             })?;
