@@ -217,12 +217,12 @@ impl Figure for Lines {
                     String::new()
                 }
             } else {
-                format!("{y}")
+                tick(*y)
             }
         };
         let decades = (y1 - y0).round().max(1.0) as usize;
         let mut mesh = chart.configure_mesh();
-        let x_label = |x: &f64| format!("{x}");
+        let x_label = |x: &f64| tick(*x);
         mesh.x_desc(&self.x_desc)
             .y_desc(&self.y_desc)
             .x_label_formatter(&x_label)
@@ -264,6 +264,13 @@ impl Figure for Lines {
             .collect();
         legend(&legend_area, &entries, Swatch::Line)
     }
+}
+
+/// A tick label: the value rounded to 1e-6, so that a tick at 0.7999999999 (the
+/// sum of floating steps) reads 0.8.
+fn tick(value: f64) -> String {
+    let rounded = (value * 1e6).round() / 1e6;
+    format!("{}", if rounded == 0.0 { 0.0 } else { rounded })
 }
 
 /// Share of a figure's width kept for the legend, right of the plot.
@@ -500,6 +507,15 @@ fn diverging(v: f64) -> RGBColor {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tick_labels_read_as_the_steps_they_are() {
+        assert_eq!(tick(0.7999999999999999), "0.8");
+        assert_eq!(tick(0.30000000000000004), "0.3");
+        assert_eq!(tick(-1e-12), "0");
+        assert_eq!(tick(12.5), "12.5");
+        assert_eq!(tick(-5.0), "-5");
+    }
 
     #[test]
     fn bars_and_lines_render_to_svg_and_png_with_the_bundled_font() {
