@@ -56,9 +56,9 @@ pub struct LearningLoop {
     template: Problem,
     experience: Experience,
     next_plan: Plan,
-    /// The standard ALC's plan, checked safe: what the safety layer drives when it
-    /// refuses `next_plan`.
-    fallback_plan: Plan,
+    /// With the safety layer on, the standard ALC's plan and its predicted safety
+    /// (checked safe): what the layer drives when it refuses `next_plan`.
+    fallback: Option<(Plan, SafetyMetrics)>,
     /// Compute time of the step that produced `next_plan`.
     pending_times: Timings,
     records: Vec<LaneChangeRecord>,
@@ -108,22 +108,26 @@ impl LearningLoop {
                 reason: "the user does not change lanes within the horizon".to_owned(),
             })?
             .sample(setup.horizon, setup.dt);
-        let standard = setup.standard_lane_change(&config.planning.standard_alc);
-        let standard_weights = config
-            .standard_weights
-            .weights(&standard, setup.horizon, setup.dt);
-        let fallback_plan = planner.plan(&problem(&setup, standard_weights, Vec::new()))?;
-        let fallback_safety = plan_safety(&setup, &fallback_plan)?;
-        if let Some(violation) = unsafe_because(&fallback_safety)
-            && config.planning.safety.enforce
-        {
-            return Err(HarnessError::Scenario {
-                scenario: config.label(),
-                reason: format!(
-                    "no safe lane change: the standard ALC's plan is refused ({violation})"
-                ),
-            });
-        }
+        let fallback = if config.planning.safety.enforce {
+            let standard = setup.standard_lane_change(&config.planning.standard_alc);
+            let standard_weights =
+                config
+                    .standard_weights
+                    .weights(&standard, setup.horizon, setup.dt);
+            let plan = planner.plan(&problem(&setup, standard_weights, Vec::new()))?;
+            let safety = plan_safety(&setup, &plan)?;
+            if let Some(violation) = unsafe_because(&safety) {
+                return Err(HarnessError::Scenario {
+                    scenario: config.label(),
+                    reason: format!(
+                        "no safe lane change: the standard ALC's plan is refused ({violation})"
+                    ),
+                });
+            }
+            Some((plan, safety))
+        } else {
+            None
+        };
         let template = problem(&setup, experience.weights.clone(), Vec::new());
         let (first_problem, _) = plan_problem(
             &planner,
@@ -151,7 +155,7 @@ impl LearningLoop {
             template,
             experience,
             next_plan,
-            fallback_plan,
+            fallback,
             pending_times,
             records: Vec::new(),
             takeovers: 0,
@@ -267,12 +271,9 @@ impl LearningLoop {
     /// plan returned and the reason for a refusal.
     fn checked_plan(&self) -> Result<(Plan, SafetyMetrics, Option<Violation>), HarnessError> {
         let predicted = plan_safety(&self.setup, &self.next_plan)?;
-        match unsafe_because(&predicted).filter(|_| self.setup.safety.enforce) {
-            None => Ok((self.next_plan.clone(), predicted, None)),
-            Some(violation) => {
-                let fallback = plan_safety(&self.setup, &self.fallback_plan)?;
-                Ok((self.fallback_plan.clone(), fallback, Some(violation)))
-            }
+        match (unsafe_because(&predicted), &self.fallback) {
+            (Some(violation), Some((plan, safety))) => Ok((plan.clone(), *safety, Some(violation))),
+            _ => Ok((self.next_plan.clone(), predicted, None)),
         }
     }
 
