@@ -177,6 +177,23 @@ pub struct TestbedConfig {
     pub adjacent_headways_m: Vec<f64>,
     /// Seeds; each cell of the grid is one (speed case, headway, seed).
     pub seeds: Vec<u64>,
+    /// A stress scene: the preceding vehicle brakes hard during the approach instead
+    /// of following the IDM. None (the paper's test bed) if absent.
+    #[serde(default)]
+    pub preceding_braking: Option<PrecedingBrakingConfig>,
+}
+
+/// `[testbed.preceding_braking]`: the preceding vehicle holds the background speed,
+/// then brakes at a constant deceleration down to a fraction of it, and holds that.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PrecedingBrakingConfig {
+    /// Time from the start of the scene at which the braking starts (s).
+    pub start_s: f64,
+    /// Deceleration (m/s^2), e.g. 4 for a hard brake.
+    pub deceleration_mps2: f64,
+    /// Speed after braking, as a fraction of the background speed, in [0, 1).
+    pub final_speed_ratio: f64,
 }
 
 fn default_ego_start() -> f64 {

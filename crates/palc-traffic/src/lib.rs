@@ -45,13 +45,16 @@ pub mod units;
 mod vehicle;
 
 pub use config::{
-    FollowerConfig, IdmConfig, MAX_SPEED_MPH, PlatoonConfig, ProfilePointConfig, RoadConfig,
-    ScenarioConfig, SpeedCaseConfig, TestbedConfig, VehicleConfig,
+    FollowerConfig, IdmConfig, MAX_SPEED_MPH, PlatoonConfig, PrecedingBrakingConfig,
+    ProfilePointConfig, RoadConfig, ScenarioConfig, SpeedCaseConfig, TestbedConfig, VehicleConfig,
 };
 pub use error::{ConfigError, SceneError};
 pub use idm::{BallisticStep, DesiredGap, IdmParams, MIN_INTERACTION_GAP, ballistic_step};
 pub use prediction::{MAX_HORIZON_STEPS, Prediction, PredictionModel};
 pub use road::{Lane, MAX_LANES, Road};
 pub use scene::{MAX_DT, MAX_VEHICLES, Scene};
-pub use testbed::{MAX_POSITION_JITTER_M, PAPER_ADJACENT_HEADWAYS, SpeedCase, TestbedCell};
+pub use testbed::{
+    MAX_POSITION_JITTER_M, MAX_PRECEDING_DECELERATION_MPS2, PAPER_ADJACENT_HEADWAYS, SpeedCase,
+    TestbedCell,
+};
 pub use vehicle::{Driver, EgoState, SpeedProfile, Vehicle, VehicleId, VehicleState};

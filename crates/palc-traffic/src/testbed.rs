@@ -13,13 +13,14 @@
 //! - every background vehicle but the preceding one gets a uniform position jitter.
 
 use crate::config::{
-    MAX_SPEED_MPH, ScenarioConfig, TestbedConfig, in_range, out_of_range, positive,
+    MAX_SPEED_MPH, PrecedingBrakingConfig, ScenarioConfig, TestbedConfig, in_range, out_of_range,
+    positive,
 };
 use crate::error::ConfigError;
 use crate::road::Lane;
 use crate::scene::{MAX_VEHICLES, Scene};
 use crate::units::{mph_to_mps, mps_to_mph};
-use crate::vehicle::{Driver, Vehicle, VehicleId, VehicleState};
+use crate::vehicle::{Driver, SpeedProfile, Vehicle, VehicleId, VehicleState};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -58,6 +59,53 @@ impl SpeedCase {
             SpeedCase::from_mph("arterial-slow", 65.0, 55.0),
         ]
     }
+}
+
+/// Largest `testbed.preceding_braking.deceleration_mps2` (m/s^2): about the friction
+/// limit of a passenger car on dry asphalt.
+pub const MAX_PRECEDING_DECELERATION_MPS2: f64 = 10.0;
+
+/// The preceding vehicle's speed profile of a braking stress scene: the background
+/// speed until `start_s`, then a constant deceleration down to the final speed.
+fn braking_profile(
+    braking: &PrecedingBrakingConfig,
+    v_bg: f64,
+) -> Result<SpeedProfile, ConfigError> {
+    let start = in_range(
+        "testbed.preceding_braking.start_s",
+        braking.start_s,
+        0.0,
+        3600.0,
+        "in [0, 3600] s",
+    )?;
+    let deceleration = in_range(
+        "testbed.preceding_braking.deceleration_mps2",
+        braking.deceleration_mps2,
+        0.1,
+        MAX_PRECEDING_DECELERATION_MPS2,
+        &format!("in [0.1, {MAX_PRECEDING_DECELERATION_MPS2}] m/s^2"),
+    )?;
+    let ratio = in_range(
+        "testbed.preceding_braking.final_speed_ratio",
+        braking.final_speed_ratio,
+        0.0,
+        0.99,
+        "in [0, 0.99]",
+    )?;
+    let final_speed = ratio * v_bg;
+    let end = start + (v_bg - final_speed) / deceleration;
+    let points = if start > 0.0 {
+        vec![(0.0, v_bg), (start, v_bg), (end, final_speed)]
+    } else {
+        vec![(0.0, v_bg), (end, final_speed)]
+    };
+    SpeedProfile::new(points).ok_or_else(|| {
+        out_of_range(
+            "testbed.preceding_braking",
+            braking.deceleration_mps2,
+            "a braking that ends after it starts",
+        )
+    })
 }
 
 /// The paper's adjacent-vehicle headways (m, front to front), from light to heavy congestion.
@@ -278,12 +326,16 @@ pub(crate) fn build(config: &ScenarioConfig, cell: &TestbedCell) -> Result<Scene
             stand_in: idm.params(v_ego),
         },
     ));
+    let preceding_driver = match testbed.preceding_braking {
+        None => Driver::Idm(idm.params(v_bg)),
+        Some(braking) => Driver::Scripted(braking_profile(&braking, v_bg)?),
+    };
     let preceding = vehicle(
         1,
         Lane(0),
         ego_start + time_headway * v_ego,
         v_bg,
-        Driver::Idm(idm.params(v_bg)),
+        preceding_driver,
     );
     inside(&preceding, "testbed.initial_time_headway_s")?;
     vehicles.push(preceding);

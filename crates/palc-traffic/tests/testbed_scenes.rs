@@ -272,3 +272,42 @@ proptest! {
         prop_assert!(a.collisions().is_empty());
     }
 }
+
+/// The braking stress scene: the preceding vehicle holds the background speed until
+/// the braking starts, loses `deceleration_mps2` each second, and holds the final
+/// speed; a braking outside its bounds is refused naming the field.
+#[test]
+fn the_preceding_vehicle_of_the_braking_scene_follows_its_profile() {
+    let mut config = testbed();
+    let testbed = config.testbed.as_mut().unwrap();
+    testbed.preceding_braking = Some(palc_traffic::PrecedingBrakingConfig {
+        start_s: 2.0,
+        deceleration_mps2: 4.0,
+        final_speed_ratio: 0.5,
+    });
+    let mut scene = Scene::from_config(&config, 0).unwrap();
+    let v_bg = scene.preceding().unwrap().state.v;
+    let speed_at = |scene: &Scene| scene.preceding().unwrap().state.v;
+    let dt = 0.1;
+    let mut speeds = vec![speed_at(&scene)];
+    for _ in 0..100 {
+        let next = cruise(&scene, dt);
+        scene.step(dt, next).unwrap();
+        speeds.push(speed_at(&scene));
+    }
+    assert!((speeds[20] - v_bg).abs() < 1e-9, "{}", speeds[20]);
+    assert!((speeds[30] - (v_bg - 4.0)).abs() < 1e-9, "{}", speeds[30]);
+    assert!((speeds[100] - 0.5 * v_bg).abs() < 1e-9, "{}", speeds[100]);
+
+    let testbed = config.testbed.as_mut().unwrap();
+    testbed.preceding_braking = Some(palc_traffic::PrecedingBrakingConfig {
+        start_s: 2.0,
+        deceleration_mps2: 40.0,
+        final_speed_ratio: 0.5,
+    });
+    let err = Scene::from_config(&config, 0).unwrap_err().to_string();
+    assert!(
+        err.contains("testbed.preceding_braking.deceleration_mps2"),
+        "{err}"
+    );
+}
