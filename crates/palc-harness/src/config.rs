@@ -204,25 +204,8 @@ impl Default for StoppingConfig {
 /// Parses TOML text; an error names the dotted path of the field it is in (e.g.
 /// `planning.standard_alc.time_headway_s`) besides the line and column that `toml` reports.
 fn from_toml<'de, T: Deserialize<'de>>(text: &'de str) -> Result<T, HarnessError> {
-    let deserializer =
-        toml::de::Deserializer::parse(text).map_err(|source| HarnessError::Toml {
-            path: String::new(),
-            error: Box::new(source),
-        })?;
-    serde_path_to_error::deserialize(deserializer).map_err(|error| {
-        let path = error.path();
-        let known = path
-            .iter()
-            .any(|segment| !matches!(segment, serde_path_to_error::Segment::Unknown));
-        HarnessError::Toml {
-            path: if known {
-                path.to_string()
-            } else {
-                String::new()
-            },
-            error: Box::new(error.into_inner()),
-        }
-    })
+    palc_traffic::parse_toml(text)
+        .map_err(|palc_traffic::TomlParseError { path, error }| HarnessError::Toml { path, error })
 }
 
 impl LearnConfig {

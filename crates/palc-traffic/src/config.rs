@@ -12,18 +12,34 @@ use serde::{Deserialize, Serialize};
 /// Parses TOML text; an error names the dotted path of the field it is in (e.g.
 /// `road.lanes`) besides the line and column that `toml` reports.
 fn from_toml<'de, T: Deserialize<'de>>(text: &'de str) -> Result<T, ConfigError> {
-    let deserializer = toml::de::Deserializer::parse(text).map_err(|source| ConfigError::Toml {
+    parse_toml(text).map_err(|TomlParseError { path, error }| ConfigError::Toml { path, error })
+}
+
+/// A TOML parse error and the dotted path of the field it is in.
+#[derive(Debug)]
+pub struct TomlParseError {
+    /// Dotted path of the field (`a.b[2].c`); empty for a syntax error, which has no field.
+    pub path: String,
+    /// The parse error, with its line and column.
+    pub error: Box<toml::de::Error>,
+}
+
+/// Parses TOML text into `T`, keeping the path of the field an error is in: the one
+/// TOML reader of every config of palc (scenario, learning and evaluation configs),
+/// each of which maps the error into its own type.
+pub fn parse_toml<'de, T: Deserialize<'de>>(text: &'de str) -> Result<T, TomlParseError> {
+    let deserializer = toml::de::Deserializer::parse(text).map_err(|source| TomlParseError {
         path: String::new(),
         error: Box::new(source),
     })?;
-    serde_path_to_error::deserialize(deserializer).map_err(|error| ConfigError::Toml {
+    serde_path_to_error::deserialize(deserializer).map_err(|error| TomlParseError {
         path: field_path(error.path()),
         error: Box::new(error.into_inner()),
     })
 }
 
 /// The dotted path of a field (`a.b[2].c`), or an empty string when nothing of it is known.
-pub(crate) fn field_path(path: &serde_path_to_error::Path) -> String {
+fn field_path(path: &serde_path_to_error::Path) -> String {
     if path
         .iter()
         .all(|segment| matches!(segment, serde_path_to_error::Segment::Unknown))

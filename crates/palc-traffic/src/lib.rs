@@ -46,7 +46,8 @@ mod vehicle;
 
 pub use config::{
     FollowerConfig, IdmConfig, MAX_SPEED_MPH, PlatoonConfig, PrecedingBrakingConfig,
-    ProfilePointConfig, RoadConfig, ScenarioConfig, SpeedCaseConfig, TestbedConfig, VehicleConfig,
+    ProfilePointConfig, RoadConfig, ScenarioConfig, SpeedCaseConfig, TestbedConfig, TomlParseError,
+    VehicleConfig, parse_toml,
 };
 pub use error::{ConfigError, SceneError};
 pub use idm::{BallisticStep, DesiredGap, IdmParams, MIN_INTERACTION_GAP, ballistic_step};
