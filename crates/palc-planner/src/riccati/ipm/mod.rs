@@ -154,6 +154,10 @@ pub(crate) struct Ipm {
     // Data norms.
     norm_b: f64,
     norm_q: f64,
+    // The iterate with the best infeasibility certificate at the reduced tolerance
+    // (ratio `‖Aᵀy + Gᵀλ‖∞ / -(bᵀy + hᵀλ)`), returned when the iterations stop.
+    certificate_iterate: Iterate,
+    certificate_ratio: f64,
 }
 
 impl Ipm {
@@ -235,16 +239,17 @@ impl Ipm {
         }
         self.newton_diag.clear();
         self.newton_diag.resize(k + 1, Vector6::zeros());
-        let b = &mut self.best_iterate;
-        b.z.clear();
-        b.z.resize(k + 1, Vector6::zeros());
-        b.y_dynamics.clear();
-        b.y_dynamics.resize(k, Vector4::zeros());
-        b.sigma.clear();
-        b.sigma.resize(n_slack, 0.0);
-        for v in [&mut b.s, &mut b.lambda] {
-            v.clear();
-            v.resize(m_in, 0.0);
+        for b in [&mut self.best_iterate, &mut self.certificate_iterate] {
+            b.z.clear();
+            b.z.resize(k + 1, Vector6::zeros());
+            b.y_dynamics.clear();
+            b.y_dynamics.resize(k, Vector4::zeros());
+            b.sigma.clear();
+            b.sigma.resize(n_slack, 0.0);
+            for v in [&mut b.s, &mut b.lambda] {
+                v.clear();
+                v.resize(m_in, 0.0);
+            }
         }
         self.best = None;
         self.riccati.resize(k);
@@ -277,6 +282,7 @@ impl Ipm {
         let mut refining = false;
         let mut previous = None;
         self.best_merit = f64::INFINITY;
+        self.certificate_ratio = f64::INFINITY;
         loop {
             let measures = self.residuals(qp);
             if measures.meets(tol.gap_abs, tol.gap_rel, tol.feas) {
@@ -284,6 +290,15 @@ impl Ipm {
             }
             if measures.infeasible(INFEASIBILITY_TOLERANCE) {
                 return Outcome::PrimalInfeasible;
+            }
+            if measures.infeasible(REDUCED_INFEASIBILITY) {
+                let ratio = measures.certificate_residual / -measures.certificate_value;
+                if ratio < self.certificate_ratio {
+                    self.certificate_ratio = ratio;
+                    let mut c = std::mem::take(&mut self.certificate_iterate);
+                    save(&mut c, self);
+                    self.certificate_iterate = c;
+                }
             }
             let merit = measures.merit(tol);
             // Only an iterate that meets the reduced tolerances can be returned.
@@ -339,6 +354,15 @@ impl Ipm {
             return Outcome::AlmostSolved;
         }
         if current.infeasible(REDUCED_INFEASIBILITY) {
+            return Outcome::PrimalInfeasible;
+        }
+        // An earlier iterate's certificate: after a breakdown of the usual Riccati
+        // pass, the steps of the projected one can leave the certificate worse than it
+        // was (issue 12, a hard-zone case at `PROPTEST_CASES=20000`).
+        if self.certificate_ratio <= REDUCED_INFEASIBILITY {
+            let c = std::mem::take(&mut self.certificate_iterate);
+            restore(self, &c);
+            self.certificate_iterate = c;
             return Outcome::PrimalInfeasible;
         }
         Outcome::Failed(reason)
@@ -532,6 +556,28 @@ impl Ipm {
         }
         sum / n as f64
     }
+}
+
+/// Copies the iterate of `ipm` into `b`.
+fn save(b: &mut Iterate, ipm: &Ipm) {
+    b.z.copy_from_slice(&ipm.z);
+    b.sigma.copy_from_slice(&ipm.sigma);
+    b.y_dynamics.copy_from_slice(&ipm.y_dynamics);
+    b.s.copy_from_slice(&ipm.s);
+    b.lambda.copy_from_slice(&ipm.lambda);
+    b.y_initial = ipm.y_initial;
+    b.y_terminal = ipm.y_terminal;
+}
+
+/// Copies `b` into the iterate of `ipm`.
+fn restore(ipm: &mut Ipm, b: &Iterate) {
+    ipm.z.copy_from_slice(&b.z);
+    ipm.sigma.copy_from_slice(&b.sigma);
+    ipm.y_dynamics.copy_from_slice(&b.y_dynamics);
+    ipm.s.copy_from_slice(&b.s);
+    ipm.lambda.copy_from_slice(&b.lambda);
+    ipm.y_initial = b.y_initial;
+    ipm.y_terminal = b.y_terminal;
 }
 
 /// Adds `add` to the state part of `v`.
