@@ -81,8 +81,10 @@ proptest! {
     // A fixed seed keeps CI reproducible. With the maximum-likelihood zone (ridge 0),
     // other seeds can draw a zone-centre expert whose plan the Riccati backend stops
     // at `MaxIterations` (e.g. K = 24, takeover at 0.354 K, pulls 0.263 and 0.05, the
-    // paper's options, no learnable rows); that open case is recorded in
-    // docs/paper-mapping.md, "Planner: the Riccati interior point".
+    // paper's options, no learnable rows); that case is recorded in
+    // docs/paper-mapping.md, "Planner: the Riccati interior point". Since the fixes of
+    // `the_large_budget_zone_centre_case_solves`, seeds 11 and 20261202 passed 20,000
+    // cases each; the seed stays fixed for CI.
     #![proptest_config(ProptestConfig {
         rng_seed: proptest::test_runner::RngSeed::Fixed(20261201),
         ..ProptestConfig::with_cases(32)
@@ -202,9 +204,12 @@ proptest! {
 /// The case a random seed of `weights_stay_convex_under_every_rule` drew (ML zone,
 /// zone-centre expert, apprenticeship rule, rows 2, 3, 8, 9 learnable): the plan of the
 /// lesson's user (`common::lesson`, second lesson, pull 0.05) ends at `MaxIterations`
-/// after 100 Riccati iterations although it is feasible. Open (ignored until fixed).
+/// after 100 Riccati iterations although it is feasible: from iteration 20 on the
+/// residuals are at 1e-15 and the iterates cycle with period 4 at a relative gap of
+/// 1e-2, a short predictor (0.043) on a steering bound followed each time by a
+/// corrector whose second-order term doubles `μ`. Solved in 15 iterations since the
+/// corrector drops that term after a predictor shorter than 0.1.
 #[test]
-#[ignore = "open: Riccati MaxIterations on a feasible plan (issue 12)"]
 fn the_large_budget_zone_centre_case_solves() {
     let (horizon, takeover_fraction, pulls) = (27, 0.5011578492556915, [0.6900270908148921, 0.05]);
     let options = AggregatorOptions {

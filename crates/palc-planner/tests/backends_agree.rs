@@ -770,13 +770,14 @@ const ZONE_CASE_CENTRE: [f64; 21] = [
 /// centre): clarabel refuses it as `Infeasible`; the Riccati backend stops after 11
 /// iterations on a control block that is not positive definite (step 15).
 ///
-/// Open (ignored until fixed): at iteration 11 the barrier terms on `l_18`, `l_19` make
-/// `P_17`'s `(l, φ)` block a difference of terms of order 1e17 that comes out
-/// indefinite (entries 6e7 / 1.5e8 / 3.5e8, negative determinant), so `P_16` has
-/// `φφ = -1.1e5` and `R̄_15[δ, δ] = -2e4`. Shifting `R̄` to positive definite
-/// (dynamic regularization) only moves the breakdown to step 19 one iteration later.
+/// The cause: at iteration 11 the barrier terms on `l_19` and `δ_19` (`W` of 6e20 and
+/// 8e16) make `P_17`'s `(l, φ)` block a difference of terms of order 1e21 that comes
+/// out indefinite (entries 6e7 / 1.5e8 / 3.5e8, negative determinant), so `P_16` has
+/// `φφ = -1.1e5` and `R̄_15[δ, δ]` is negative. Shifting `R̄` to positive definite
+/// only moved the breakdown to step 19 one iteration later; the recursion now repeats
+/// such a pass with every `P` projected onto the semidefinite cone, the next step
+/// brings the certificate to 6e-8 and the stop accepts it at clarabel's reduced 5e-5.
 #[test]
-#[ignore = "open: Riccati numerical failure instead of PrimalInfeasible (issue 12)"]
 fn both_backends_refuse_the_infeasible_hard_zone_of_the_large_budget_run() {
     let config = PlannerConfig {
         horizon: 20,

@@ -54,7 +54,8 @@ const TERMINAL_TOLERANCE: f64 = 1e-12;
 /// Why a factorization failed.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) enum FactorError {
-    /// `R̄` of a step is not positive definite (non-convex or non-finite data).
+    /// `R̄` of a step is not positive definite, even with every `P` projected onto the
+    /// semidefinite cone (non-convex or non-finite data).
     ControlBlock(usize),
     /// The terminal Schur complement `-W_0` is not positive definite even after
     /// regularization (non-finite data).
@@ -116,6 +117,18 @@ impl Riccati {
 
     /// Backward pass over the Hessian blocks `h + diag(d)` (`K + 1`), dynamics and the
     /// `m` terminal rows `terminal` (rows `0..m` used).
+    ///
+    /// If a control block comes out not positive definite, the pass is repeated with
+    /// every `P_i` projected onto the semidefinite cone (its negative eigenvalues set to
+    /// zero), which it is in exact arithmetic: `P_i` is the Hessian of a convex
+    /// cost-to-go. Why: once bounds are active with `W = λ / s` of 1e17-1e21 (on an
+    /// infeasible problem, whose multipliers grow without bound), `AᵀPA` and
+    /// `S̄ᵀR̄⁻¹S̄` are of that order and their difference, of order 1e8, keeps only
+    /// about 1e5 of absolute accuracy: it can come out indefinite (issue 12, `P_17` of
+    /// a hard-zone problem with a negative determinant), and the next control block
+    /// negative. The projection changes the Newton step, not the residuals, which are
+    /// always computed exactly; the usual pass is kept first because the projection
+    /// (an eigendecomposition per step) is not needed otherwise.
     pub fn factor(
         &mut self,
         h: &[Matrix6<f64>],
@@ -123,6 +136,25 @@ impl Riccati {
         dynamics: &[Dynamics],
         terminal: &Matrix4<f64>,
         m: usize,
+    ) -> Result<(), FactorError> {
+        match self.factor_with(h, d, dynamics, terminal, m, false) {
+            Err(FactorError::ControlBlock(_)) => {
+                self.factor_with(h, d, dynamics, terminal, m, true)
+            }
+            result => result,
+        }
+    }
+
+    /// The backward pass; `semidefinite_p` projects every `P_i` onto the semidefinite
+    /// cone.
+    fn factor_with(
+        &mut self,
+        h: &[Matrix6<f64>],
+        d: &[Vector6<f64>],
+        dynamics: &[Dynamics],
+        terminal: &Matrix4<f64>,
+        m: usize,
+        semidefinite_p: bool,
     ) -> Result<(), FactorError> {
         let k = self.k;
         self.m = m;
@@ -162,6 +194,9 @@ impl Riccati {
                 p[(j, j)] += diag[j];
             }
             p = (p + p.transpose()) * 0.5;
+            if semidefinite_p {
+                p = semidefinite(p);
+            }
             // Γ_i = (A + BK)ᵀ Γ = AᵀΓ + Kᵀ (BᵀΓ).
             let bt_gamma = d.b_tr_left(&self.gamma[i + 1]);
             self.gamma[i] = d.a_tr_left(&self.gamma[i + 1]) + gain.tr_mul(&bt_gamma);
@@ -245,4 +280,19 @@ impl Riccati {
         out.z[k] = Vector6::new(x[0], x[1], x[2], x[3], 0.0, 0.0);
         *out.y_terminal = *nu;
     }
+}
+
+/// The positive semidefinite matrix nearest to the symmetric `p` in the Frobenius norm:
+/// its eigendecomposition with the negative eigenvalues set to zero. Kept out of line:
+/// only the repeated pass after a breakdown calls it.
+#[cold]
+#[inline(never)]
+fn semidefinite(p: Matrix4<f64>) -> Matrix4<f64> {
+    let eigen = p.symmetric_eigen();
+    if eigen.eigenvalues.iter().all(|&e| e >= 0.0) {
+        return p;
+    }
+    let v = eigen.eigenvectors;
+    let p = v * Matrix4::from_diagonal(&eigen.eigenvalues.map(|e| e.max(0.0))) * v.transpose();
+    (p + p.transpose()) * 0.5
 }

@@ -52,6 +52,20 @@ const STAGNATION: u32 = 5;
 const MAX_STEP_FRACTION: f64 = 0.9999;
 /// Fraction of the step to the boundary of the positive orthant.
 const STEP_FRACTION: f64 = 0.995;
+/// Largest factor by which one corrected step may grow the mean complementarity `μ` once
+/// the iterate's residuals meet the tolerance; a step that grows it more is recomputed
+/// without Mehrotra's second-order term `Δs_aff ∘ Δλ_aff` (centring only, the same
+/// factorization). After a short predictor that product can be several times `μ`: on a
+/// feasible aggregator plan (issue 12, K = 27) a steering bound with `s = 2.5e-5`,
+/// `Δs = -5.8e-4`, `Δλ = 241` (predictor 0.043, `μ = 0.047`) made the corrected step
+/// double `μ`, and the iterates cycled with period 4 for 100 iterations at a relative
+/// gap of 1e-2 with the residuals at 1e-15. Once only the gap is left to close, a step
+/// that increases `μ` is a step back; 1 is the loosest bound that says so. Not applied
+/// before the residuals meet the tolerance: on an infeasible problem `μ` grows with the
+/// multipliers that become the certificate, and both this rule without that condition
+/// and dropping the term after every predictor shorter than 0.1 stopped infeasible
+/// problems on `InsufficientProgress` instead of `Infeasible`.
+const MU_GROWTH: f64 = 1.0;
 
 /// Stopping tolerances (from [`SolverSettings`](crate::SolverSettings)).
 #[derive(Debug, Clone, Copy)]
@@ -140,6 +154,10 @@ pub(crate) struct Ipm {
     // Data norms.
     norm_b: f64,
     norm_q: f64,
+    // The iterate with the best infeasibility certificate at the reduced tolerance
+    // (ratio `‖Aᵀy + Gᵀλ‖∞ / -(bᵀy + hᵀλ)`), returned when the iterations stop.
+    certificate_iterate: Iterate,
+    certificate_ratio: f64,
 }
 
 impl Ipm {
@@ -221,16 +239,17 @@ impl Ipm {
         }
         self.newton_diag.clear();
         self.newton_diag.resize(k + 1, Vector6::zeros());
-        let b = &mut self.best_iterate;
-        b.z.clear();
-        b.z.resize(k + 1, Vector6::zeros());
-        b.y_dynamics.clear();
-        b.y_dynamics.resize(k, Vector4::zeros());
-        b.sigma.clear();
-        b.sigma.resize(n_slack, 0.0);
-        for v in [&mut b.s, &mut b.lambda] {
-            v.clear();
-            v.resize(m_in, 0.0);
+        for b in [&mut self.best_iterate, &mut self.certificate_iterate] {
+            b.z.clear();
+            b.z.resize(k + 1, Vector6::zeros());
+            b.y_dynamics.clear();
+            b.y_dynamics.resize(k, Vector4::zeros());
+            b.sigma.clear();
+            b.sigma.resize(n_slack, 0.0);
+            for v in [&mut b.s, &mut b.lambda] {
+                v.clear();
+                v.resize(m_in, 0.0);
+            }
         }
         self.best = None;
         self.riccati.resize(k);
@@ -263,6 +282,7 @@ impl Ipm {
         let mut refining = false;
         let mut previous = None;
         self.best_merit = f64::INFINITY;
+        self.certificate_ratio = f64::INFINITY;
         loop {
             let measures = self.residuals(qp);
             if measures.meets(tol.gap_abs, tol.gap_rel, tol.feas) {
@@ -270,6 +290,15 @@ impl Ipm {
             }
             if measures.infeasible(INFEASIBILITY_TOLERANCE) {
                 return Outcome::PrimalInfeasible;
+            }
+            if measures.infeasible(REDUCED_INFEASIBILITY) {
+                let ratio = measures.certificate_residual / -measures.certificate_value;
+                if ratio < self.certificate_ratio {
+                    self.certificate_ratio = ratio;
+                    let mut c = std::mem::take(&mut self.certificate_iterate);
+                    save(&mut c, self);
+                    self.certificate_iterate = c;
+                }
             }
             let merit = measures.merit(tol);
             // Only an iterate that meets the reduced tolerances can be returned.
@@ -302,7 +331,8 @@ impl Ipm {
                     && measures.res_dual > REFINE_SHORTFALL * (1.0 - alpha).max(1e-3) * res_dual
             });
             let refine = refining;
-            match self.iterate(qp, refine) {
+            let feasible = measures.res_primal < tol.feas && measures.res_dual < tol.feas;
+            match self.iterate(qp, refine, feasible) {
                 Ok(alpha) => {
                     stalled = if alpha < 1e-8 { stalled + 1 } else { 0 };
                     previous = Some((measures.res_dual, alpha));
@@ -324,6 +354,15 @@ impl Ipm {
             return Outcome::AlmostSolved;
         }
         if current.infeasible(REDUCED_INFEASIBILITY) {
+            return Outcome::PrimalInfeasible;
+        }
+        // An earlier iterate's certificate: after a breakdown of the usual Riccati
+        // pass, the steps of the projected one can leave the certificate worse than it
+        // was (issue 12, a hard-zone case at `PROPTEST_CASES=20000`).
+        if self.certificate_ratio <= REDUCED_INFEASIBILITY {
+            let c = std::mem::take(&mut self.certificate_iterate);
+            restore(self, &c);
+            self.certificate_iterate = c;
             return Outcome::PrimalInfeasible;
         }
         Outcome::Failed(reason)
@@ -396,7 +435,8 @@ impl Ipm {
     }
 
     /// One predictor-corrector iteration; returns the step length.
-    fn iterate(&mut self, qp: &StageQp, refine: bool) -> Result<f64, FactorError> {
+    /// `feasible`: the residuals of the iterate meet the stopping tolerance.
+    fn iterate(&mut self, qp: &StageQp, refine: bool, feasible: bool) -> Result<f64, FactorError> {
         let n = self.s.len();
         let m_in = n as f64;
         // Predictor: r_c = s∘λ, so ξ = λ + W r_in - r_c / s = W r_in.
@@ -462,7 +502,22 @@ impl Ipm {
         }
         // Bolder steps when the predictor was good (little centring needed).
         let fraction = (1.0 - centering).clamp(STEP_FRACTION, MAX_STEP_FRACTION);
-        let alpha = (fraction * alpha).min(1.0);
+        let mut alpha = (fraction * alpha).min(1.0);
+        if feasible && self.mean_complementarity_after(alpha) > MU_GROWTH * mu {
+            // The second-order term misled the step: centre only (the last Δs, Δλ are
+            // the corrector's; r_c is rebuilt from s∘λ).
+            let shift = centering * mu;
+            for j in 0..n {
+                self.rc[j] = self.s[j] * self.lambda[j] - shift;
+                self.xi[j] = self.lambda[j] + self.w[j] * self.r_in[j] - self.rc[j] * self.inv_s[j];
+            }
+            alpha = self.newton_step(qp);
+            if refine {
+                self.refine(qp);
+                alpha = self.dual_step_to_boundary();
+            }
+            alpha = (fraction * alpha).min(1.0);
+        }
 
         for (z, dz) in self.z.iter_mut().zip(&self.dz) {
             *z += alpha * dz;
@@ -483,6 +538,46 @@ impl Ipm {
         self.y_terminal += alpha * (self.y_terminal_new - self.y_terminal);
         Ok(alpha)
     }
+}
+
+impl Ipm {
+    /// `(s + α Δs)ᵀ(λ + α Δλ) / m` for the last Newton step.
+    fn mean_complementarity_after(&self, alpha: f64) -> f64 {
+        let n = self.s.len();
+        let (s, lambda, ds, d_lambda) = (
+            &self.s[..n],
+            &self.lambda[..n],
+            &self.ds[..n],
+            &self.d_lambda[..n],
+        );
+        let mut sum = 0.0;
+        for j in 0..n {
+            sum += (s[j] + alpha * ds[j]) * (lambda[j] + alpha * d_lambda[j]);
+        }
+        sum / n as f64
+    }
+}
+
+/// Copies the iterate of `ipm` into `b`.
+fn save(b: &mut Iterate, ipm: &Ipm) {
+    b.z.copy_from_slice(&ipm.z);
+    b.sigma.copy_from_slice(&ipm.sigma);
+    b.y_dynamics.copy_from_slice(&ipm.y_dynamics);
+    b.s.copy_from_slice(&ipm.s);
+    b.lambda.copy_from_slice(&ipm.lambda);
+    b.y_initial = ipm.y_initial;
+    b.y_terminal = ipm.y_terminal;
+}
+
+/// Copies `b` into the iterate of `ipm`.
+fn restore(ipm: &mut Ipm, b: &Iterate) {
+    ipm.z.copy_from_slice(&b.z);
+    ipm.sigma.copy_from_slice(&b.sigma);
+    ipm.y_dynamics.copy_from_slice(&b.y_dynamics);
+    ipm.s.copy_from_slice(&b.s);
+    ipm.lambda.copy_from_slice(&b.lambda);
+    ipm.y_initial = b.y_initial;
+    ipm.y_terminal = b.y_terminal;
 }
 
 /// Adds `add` to the state part of `v`.
