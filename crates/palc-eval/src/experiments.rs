@@ -44,18 +44,6 @@ fn means_by(
     (categories, series)
 }
 
-/// The smallest of the three gaps of `safety` (m), if any was measured.
-fn smallest_gap(safety: &palc_harness::SafetyMetrics) -> Option<f64> {
-    [
-        safety.min_gap_preceding_m,
-        safety.min_gap_target_lead_m,
-        safety.min_gap_target_lag_m,
-    ]
-    .into_iter()
-    .flatten()
-    .min_by(f64::total_cmp)
-}
-
 /// The empirical distribution function of `values` as points `(value, fraction at or
 /// below)`, thinned to at most 200 points.
 fn empirical_cdf(mut values: Vec<f64>) -> Vec<(f64, f64)> {
@@ -226,7 +214,7 @@ pub fn draw_all(
                     .iter()
                     .filter(|r| r.spec.experiment == Experiment::Grid && r.spec.method == m)
                     .flat_map(|r| &r.iterations)
-                    .filter_map(|i| smallest_gap(&i.safety));
+                    .filter_map(|i| i.safety.min_gap_m());
                 (m.name().to_owned(), empirical_cdf(values.collect()))
             })
             .filter(|(_, points)| !points.is_empty())

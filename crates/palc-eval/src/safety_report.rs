@@ -8,6 +8,7 @@ use palc_harness::{Method, SafetyMetrics};
 
 use crate::plan::Experiment;
 use crate::results::{Iteration, RunRow};
+use crate::stats::percentile;
 
 /// Writes the section.
 pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
@@ -79,14 +80,14 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
     }
 }
 
-/// `p5 / min` of `values` with one decimal, `-` when there are none.
+/// `p5 / min` of `values` (nearest-rank percentile) with one decimal, `-` when
+/// there are none.
 fn low_tail(mut values: Vec<f64>) -> String {
     if values.is_empty() {
         return "-".to_owned();
     }
     values.sort_by(f64::total_cmp);
-    let p5 = values[((values.len() - 1) as f64 * 0.05).round() as usize];
-    format!("{p5:.1} / {:.1}", values[0])
+    format!("{:.1} / {:.1}", percentile(&values, 0.05), values[0])
 }
 
 #[cfg(test)]

@@ -116,7 +116,7 @@ impl LearningLoop {
                     .weights(&standard, setup.horizon, setup.dt);
             let plan = planner.plan(&problem(&setup, standard_weights, Vec::new()))?;
             let safety = plan_safety(&setup, &plan)?;
-            if let Some(violation) = unsafe_because(&safety) {
+            if let Some(violation) = safety.first_violation {
                 return Err(HarnessError::Scenario {
                     scenario: config.label(),
                     reason: format!(
@@ -271,7 +271,7 @@ impl LearningLoop {
     /// plan returned and the reason for a refusal.
     fn checked_plan(&self) -> Result<(Plan, SafetyMetrics, Option<Violation>), HarnessError> {
         let predicted = plan_safety(&self.setup, &self.next_plan)?;
-        match (unsafe_because(&predicted), &self.fallback) {
+        match (predicted.first_violation, &self.fallback) {
             (Some(violation), Some((plan, safety))) => Ok((plan.clone(), *safety, Some(violation))),
             _ => Ok((self.next_plan.clone(), predicted, None)),
         }
@@ -384,15 +384,6 @@ impl LearningLoop {
             final_takeover_rate: rate(|r| r.takeover.is_some()),
             ceiling_takeover_rate: rate(|r| r.nominal_plan_taken_over),
         }
-    }
-}
-
-/// Why predicted `safety` is not safe: its first violation, or `None` when it is safe.
-fn unsafe_because(safety: &SafetyMetrics) -> Option<Violation> {
-    if safety.is_safe() {
-        None
-    } else {
-        safety.first_violation
     }
 }
 

@@ -178,7 +178,7 @@ pub struct SafetyMetrics {
     /// Steps at which a gap the ego is responsible for was below the safe distance,
     /// or at which the footprints overlapped.
     pub rss_violations: usize,
-    /// The first of them.
+    /// The first of them; `None` exactly when the lane change was safe.
     pub first_violation: Option<Violation>,
 }
 
@@ -186,6 +186,18 @@ impl SafetyMetrics {
     /// Whether the lane change was free of collisions and safe-distance violations.
     pub fn is_safe(&self) -> bool {
         !self.collision && self.rss_violations == 0
+    }
+
+    /// The smallest net gap to any of the three vehicles (m).
+    pub fn min_gap_m(&self) -> Option<f64> {
+        [
+            self.min_gap_preceding_m,
+            self.min_gap_target_lead_m,
+            self.min_gap_target_lag_m,
+        ]
+        .into_iter()
+        .flatten()
+        .min_by(f64::total_cmp)
     }
 
     /// The smallest time to collision with any of the three vehicles (s).
@@ -230,11 +242,25 @@ impl SafetyMonitor {
         let Some(ego) = scene.ego() else { return };
         let road = scene.road();
         let mut worst: Option<Violation> = None;
-        let others = scene
-            .vehicles()
-            .iter()
-            .filter(|v| !matches!(v.driver, Driver::External { .. }));
-        for other in others {
+        let others = || {
+            scene
+                .vehicles()
+                .iter()
+                .filter(|v| !matches!(v.driver, Driver::External { .. }))
+        };
+        // The target lane's lead and lag: its nearest vehicles ahead of and behind the ego.
+        let nearest_on_target = |ahead: bool| {
+            others()
+                .filter(|v| v.lane == self.target_lane && (v.state.s > ego.state.s) == ahead)
+                .min_by(|a, b| {
+                    (a.state.s - ego.state.s)
+                        .abs()
+                        .total_cmp(&(b.state.s - ego.state.s).abs())
+                })
+                .map(|v| v.id.0)
+        };
+        let (lead, lag) = (nearest_on_target(true), nearest_on_target(false));
+        for other in others() {
             let collided = overlap(ego, other);
             self.metrics.collision |= collided;
             if !collided && !road.occupies(ego.state.l, ego.width, other.lane) {
@@ -246,7 +272,12 @@ impl SafetyMonitor {
             } else {
                 (ego.rear() - other.state.s, other.state.v, ego.state.v)
             };
-            let role = self.role(scene, other, ahead);
+            let role = match Some(other.id.0) {
+                id if id == self.preceding => Role::Preceding,
+                id if id == lead => Role::TargetLead,
+                id if id == lag => Role::TargetLag,
+                _ => Role::Other,
+            };
             let closing = rear_v - front_v;
             let ttc = (closing > 0.0).then(|| gap.max(0.0) / closing);
             let (gap_slot, ttc_slot) = match role {
@@ -293,34 +324,6 @@ impl SafetyMonitor {
     /// What was measured.
     pub fn metrics(&self) -> SafetyMetrics {
         self.metrics
-    }
-
-    fn role(&self, scene: &Scene, other: &Vehicle, ahead: bool) -> Role {
-        if Some(other.id.0) == self.preceding {
-            return Role::Preceding;
-        }
-        if other.lane != self.target_lane {
-            return Role::Other;
-        }
-        let Some(ego) = scene.ego() else {
-            return Role::Other;
-        };
-        // The nearest target-lane vehicle on the same side of the ego.
-        let nearest = scene
-            .vehicles()
-            .iter()
-            .filter(|v| v.lane == self.target_lane && !matches!(v.driver, Driver::External { .. }))
-            .filter(|v| (v.state.s > ego.state.s) == ahead)
-            .min_by(|a, b| {
-                (a.state.s - ego.state.s)
-                    .abs()
-                    .total_cmp(&(b.state.s - ego.state.s).abs())
-            });
-        match (nearest.map(|v| v.id) == Some(other.id), ahead) {
-            (true, true) => Role::TargetLead,
-            (true, false) => Role::TargetLag,
-            (false, _) => Role::Other,
-        }
     }
 }
 

@@ -195,7 +195,7 @@ impl Setup {
                 trigger = Some(step);
                 break;
             }
-            lane_keeping_step(&mut scene, config, set_speed, false)?;
+            lane_keeping_step(&mut scene, config, set_speed, None)?;
         }
         if trigger.is_none() {
             return Err(scenario_error(format!(
@@ -239,7 +239,12 @@ impl Setup {
             // is longer) has decided to change lanes; the search then goes on.
             seeking |= situations[step].decides_at(config.standard_alc.time_headway_s);
             if step < window {
-                lane_keeping_step(&mut rollout, config, set_speed, seeking)?;
+                lane_keeping_step(
+                    &mut rollout,
+                    config,
+                    set_speed,
+                    seeking.then_some(&situations[step]),
+                )?;
             }
         }
 
@@ -392,22 +397,24 @@ fn target_gaps_safe(situation: &Situation, safety: &SafetyConfig) -> bool {
     lead_ok && lag_ok
 }
 
-/// One simulation step with the ego keeping its lane under its ACC; when
-/// `seeking_gap`, the ego also drops back while the gap beside it is unsafe.
+/// One simulation step with the ego keeping its lane under its ACC; when seeking
+/// a gap (`seeking` holds what the ego sees now), it also drops back while the gap
+/// beside it is not acceptable.
 fn lane_keeping_step(
     scene: &mut Scene,
     config: &PlanningConfig,
     set_speed: f64,
-    seeking_gap: bool,
+    seeking: Option<&Situation>,
 ) -> Result<(), HarnessError> {
     let ego = scene.ego().map(|e| e.state).unwrap_or_default();
     let mut acceleration = config.acc.acceleration(ego.v, set_speed, acc_leader(scene));
     // Gap seeking: while the gap beside is neither acceptable to the standard ALC
     // nor safe, drop back below the target lane's speed so that the next gap
     // comes alongside.
-    let seen = situation(scene);
-    let acceptable = config.standard_alc.accepts(&seen) && target_gaps_safe(&seen, &config.safety);
-    if seeking_gap && config.acc.enabled && !acceptable {
+    let unacceptable = |seen: &&Situation| {
+        !(config.standard_alc.accepts(seen) && target_gaps_safe(seen, &config.safety))
+    };
+    if let Some(seen) = seeking.filter(unacceptable).filter(|_| config.acc.enabled) {
         let flow = [seen.target_lead_speed, seen.target_lag_speed]
             .into_iter()
             .flatten()

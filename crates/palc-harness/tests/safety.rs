@@ -55,13 +55,9 @@ fn drive(
     monitor.metrics()
 }
 
-#[test]
-fn the_acc_does_not_hit_a_leader_that_brakes_hard_to_a_stop() {
-    let acc = AccConfig {
-        enabled: true,
-        ..AccConfig::default()
-    };
-    // The leader brakes at -4 m/s^2 from 25 m/s to a stop, 2 s into the scene.
+/// Both at 25 m/s, the leader's rear 22 m ahead; it brakes at -4 m/s^2 to a stop,
+/// 2 s into the scene.
+fn braking_leader() -> Scene {
     let profile = SpeedProfile::new(vec![(0.0, 25.0), (2.0, 25.0), (8.25, 0.0)]).unwrap();
     let scene = Scene::new(
         Road::paper(),
@@ -72,6 +68,16 @@ fn the_acc_does_not_hit_a_leader_that_brakes_hard_to_a_stop() {
         9.0,
     )
     .unwrap();
+    scene
+}
+
+#[test]
+fn the_acc_does_not_hit_a_leader_that_brakes_hard_to_a_stop() {
+    let acc = AccConfig {
+        enabled: true,
+        ..AccConfig::default()
+    };
+    let scene = braking_leader();
     let metrics = drive(scene, 200, |scene| {
         let e = scene.ego().unwrap().state;
         let a = acc.acceleration(e.v, 25.0, acc_leader(scene));
@@ -88,16 +94,7 @@ fn the_acc_does_not_hit_a_leader_that_brakes_hard_to_a_stop() {
 
 #[test]
 fn an_ego_that_holds_its_speed_behind_the_same_leader_collides_and_is_flagged() {
-    let profile = SpeedProfile::new(vec![(0.0, 25.0), (2.0, 25.0), (8.25, 0.0)]).unwrap();
-    let scene = Scene::new(
-        Road::paper(),
-        vec![
-            ego(0.0, 25.0),
-            vehicle(1, Lane(0), 27.0, 25.0, Driver::Scripted(profile)),
-        ],
-        9.0,
-    )
-    .unwrap();
+    let scene = braking_leader();
     let metrics = drive(scene, 100, |scene| {
         let e = scene.ego().unwrap().state;
         EgoState {
