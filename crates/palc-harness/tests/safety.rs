@@ -59,7 +59,7 @@ fn drive(
 /// 2 s into the scene.
 fn braking_leader() -> Scene {
     let profile = SpeedProfile::new(vec![(0.0, 25.0), (2.0, 25.0), (8.25, 0.0)]).unwrap();
-    let scene = Scene::new(
+    Scene::new(
         Road::paper(),
         vec![
             ego(0.0, 25.0),
@@ -67,8 +67,7 @@ fn braking_leader() -> Scene {
         ],
         9.0,
     )
-    .unwrap();
-    scene
+    .unwrap()
 }
 
 #[test]
