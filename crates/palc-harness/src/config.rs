@@ -8,7 +8,7 @@ use crate::HarnessError;
 use crate::method::Method;
 use crate::setup::PlanningConfig;
 use crate::standard_alc::StandardWeights;
-use crate::user::{Spread, Style, StylePreset};
+use crate::user::{Family, SimulatedUser, Spread, Style, StylePreset};
 
 /// Everything that describes one run of the lesson-learning loop.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -53,7 +53,8 @@ pub struct CellChoice {
     pub seed: u64,
 }
 
-/// The simulated user: a preset or custom style, and an optional spread.
+/// The simulated user: a preset or custom style, the family of rules that
+/// refines it, and an optional spread.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct UserConfig {
@@ -62,6 +63,10 @@ pub struct UserConfig {
     /// The style when `style = "custom"`.
     #[serde(default)]
     pub custom: Option<Style>,
+    /// The family's rules (`[user.family]`): start rule, reaction, lateral profile,
+    /// speed, perceived-safety takeover; the paper's user by default.
+    #[serde(default)]
+    pub family: Option<Family>,
     /// Spread of the user's parameters between lane changes; none by default.
     #[serde(default)]
     pub spread: Option<Spread>,
@@ -73,8 +78,24 @@ impl UserConfig {
         UserConfig {
             style: UserStyle::Preset(preset),
             custom: None,
+            family: None,
             spread: None,
         }
+    }
+
+    /// The simulated user of this config, taking over beyond `deviation_m`.
+    ///
+    /// # Errors
+    /// [`HarnessError::InvalidConfig`] naming the field of a parameter out of bound.
+    pub fn simulated(&self, deviation_m: f64) -> Result<SimulatedUser, HarnessError> {
+        let family = self.family.clone().unwrap_or_default();
+        let name = match &self.family {
+            Some(family) if *family != Family::default() => {
+                format!("{} ({})", self.style, family.describe())
+            }
+            _ => self.style.to_string(),
+        };
+        SimulatedUser::new(name, self.style()?, family, deviation_m, self.spread)
     }
 
     /// The nominal style of this user.
@@ -238,8 +259,8 @@ impl LearnConfig {
     /// Checks the parts that can be checked without building the scene.
     pub fn validate(&self) -> Result<(), HarnessError> {
         self.traffic.validate()?;
-        self.user.style()?;
         self.planning.validate()?;
+        self.user.simulated(self.planning.takeover_threshold_m)?;
         let s = &self.stopping;
         for (field, value, max) in [
             ("loop.max_takeovers", s.max_takeovers, MAX_TAKEOVERS),

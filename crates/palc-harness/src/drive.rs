@@ -7,8 +7,8 @@ use crate::HarnessError;
 use crate::acc::acc_leader;
 use crate::record::Takeover;
 use crate::safety::{SafetyMetrics, SafetyMonitor};
-use crate::setup::Setup;
-use crate::user::{ExpectedLaneChange, first_takeover, max_deviation};
+use crate::setup::{Setup, situation};
+use crate::user::{Expectation, ExpectedLaneChange, TakeoverCause, User, max_deviation};
 
 /// The planning problem of this scenario with the given weights and lateral bounds.
 ///
@@ -74,25 +74,50 @@ pub struct Drive {
     pub user_safety: SafetyMetrics,
 }
 
-/// Drives `plan` in a clone of the scene; the user of `expected` takes over at the
-/// first step deviating more than `threshold` and then drives the expected lateral
-/// path, its speed set by the ego's ACC behind whatever is ahead in the lanes it
-/// occupies.
+/// The first step at which `user`, expecting `expectation`, takes over the ego
+/// driving `states` (plan frame, from the trigger) in a clone of the scene, and why.
+///
+/// # Errors
+/// A scene error while driving.
+pub fn judge(
+    setup: &Setup,
+    user: &dyn User,
+    expectation: &Expectation,
+    states: &[State],
+) -> Result<Option<(usize, TakeoverCause)>, HarnessError> {
+    let mut scene = setup.scene.clone();
+    for (i, state) in states.iter().enumerate() {
+        if i > 0 {
+            scene.step(setup.dt, ego_state(setup, state))?;
+        }
+        if let Some(cause) = user.takes_over(expectation, i, state, &situation(&scene)) {
+            return Ok(Some((i, cause)));
+        }
+    }
+    Ok(None)
+}
+
+/// Drives `plan` in a clone of the scene; `user`, expecting `expectation`, judges
+/// each step as it is driven ([`User::takes_over`]) and after a takeover drives
+/// its expected lateral path, at the acceleration of
+/// [`User::acceleration_after_takeover`] (by default the ego's ACC behind
+/// whatever is ahead in the lanes it occupies).
 pub fn execute(
     setup: &Setup,
     plan: Plan,
-    expected: ExpectedLaneChange,
-    threshold: f64,
+    user: &dyn User,
+    expectation: &Expectation,
 ) -> Result<Drive, HarnessError> {
     let k = setup.horizon;
     let dt = setup.dt;
     let planned_l: Vec<f64> = plan.states.iter().map(|x| x.l).collect();
-    let expected_l = expected.sample(k, dt);
-    let takeover_step = first_takeover(&planned_l, &expected_l, threshold);
+    let expected_l = expectation.lateral(k);
+    let judged = judge(setup, user, expectation, &plan.states)?;
+    let takeover_step = judged.map(|(step, _)| step);
 
     let mut scene = setup.scene.clone();
     let mut system = SafetyMonitor::new(setup.safety, &scene, setup.target_l);
-    let mut user = system.clone();
+    let mut by_user_monitor = system.clone();
     let mut driven: Vec<State> = Vec::with_capacity(k + 1);
     let mut preceding = Vec::with_capacity(k + 1);
     let mut adjacent = Vec::with_capacity(k + 1);
@@ -108,10 +133,11 @@ pub fn execute(
                 ..plan.states[0]
             },
             (true, Some(previous)) => {
+                let acc = setup
+                    .acc
+                    .acceleration(previous.v, setup.set_speed, acc_leader(&scene));
                 let acceleration =
-                    setup
-                        .acc
-                        .acceleration(previous.v, setup.set_speed, acc_leader(&scene));
+                    user.acceleration_after_takeover(expectation, i, previous.v, acc);
                 let moved = ballistic_step(previous.v, acceleration, dt);
                 State {
                     s: previous.s + moved.distance,
@@ -125,7 +151,7 @@ pub fn execute(
             scene.step(dt, ego_state(setup, &state))?;
         }
         if by_user {
-            user.observe(i, &scene);
+            by_user_monitor.observe(i, &scene);
         } else {
             system.observe(i, &scene);
         }
@@ -141,11 +167,12 @@ pub fn execute(
         }
     }
 
-    let takeover = takeover_step.map(|step| Takeover {
+    let takeover = judged.map(|(step, cause)| Takeover {
         step,
         time_s: step as f64 * dt,
         distance_m: plan.states[step].s,
         deviation_m: (planned_l[step] - expected_l[step]).abs(),
+        cause,
     });
     let perceived_safety_ratio = match &takeover {
         None => 1.0,
@@ -167,7 +194,7 @@ pub fn execute(
     Ok(Drive {
         max_deviation_m: max_deviation(&planned_l, &expected_l),
         plan,
-        expected,
+        expected: expectation.lane_change.clone(),
         expected_l,
         takeover,
         driven,
@@ -175,7 +202,7 @@ pub fn execute(
         adjacent,
         perceived_safety_ratio,
         safety: system.metrics(),
-        user_safety: user.metrics(),
+        user_safety: by_user_monitor.metrics(),
     })
 }
 

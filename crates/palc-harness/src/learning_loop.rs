@@ -14,7 +14,7 @@ use palc_planner::{LateralBoundsMode, Plan, Planner, PlannerConfig, Problem};
 
 use crate::HarnessError;
 use crate::config::{LearnConfig, StoppingConfig};
-use crate::drive::{Drive, execute, plan_safety, problem};
+use crate::drive::{Drive, execute, judge, plan_safety, problem};
 use crate::learn::{RunResult, aggregator_options, prepare};
 use crate::lesson::{lesson, scenes, zone_feature_set};
 use crate::method::Method;
@@ -22,7 +22,7 @@ use crate::observer::{LessonEvent, Observer};
 use crate::record::{LaneChangeRecord, Outcome, RunSummary};
 use crate::safety::{SafetyMetrics, Violation};
 use crate::setup::Setup;
-use crate::user::{User, first_takeover};
+use crate::user::{Expectation, User};
 
 /// One run of the lesson-learning loop (paper Fig. 2): plan with the experience,
 /// let the simulated user judge the lane change, and on a takeover label the lesson,
@@ -45,13 +45,12 @@ pub struct LearningLoop {
     label: String,
     method: Method,
     stopping: StoppingConfig,
-    takeover_threshold_m: f64,
     options: AggregatorOptions,
     setup: Setup,
     planner: Planner,
-    user: User,
-    /// The user's nominal expected lateral path: the ceiling of a user with spread.
-    nominal_l: Vec<f64>,
+    user: Box<dyn User>,
+    /// The user's nominal expected lane change: the ceiling of a user with spread.
+    nominal: Expectation,
     /// The scenario without weights or zone: the aggregator fills both in.
     template: Problem,
     experience: Experience,
@@ -78,12 +77,52 @@ impl LearningLoop {
     ///
     /// # Errors
     /// Invalid config or options, a scenario the paper's premise does not hold in
-    /// ([`HarnessError::Scenario`]), or a first plan that cannot be solved.
+    /// ([`HarnessError::Scenario`]), a user without a sane lane change in it, or a
+    /// first plan that cannot be solved.
     pub fn new(
         config: &LearnConfig,
         experience: Option<&Experience>,
     ) -> Result<Self, HarnessError> {
-        let setup = prepare(config)?;
+        let user = config
+            .user
+            .simulated(config.planning.takeover_threshold_m)?;
+        Self::with_user(config, experience, Box::new(user))
+    }
+
+    /// As [`LearningLoop::new`], with a user of the caller's own instead of the
+    /// config's `[user]`: a recorded driver, a person at a simulator, another
+    /// model. The horizon is extended to cover the user's nominal lane change when
+    /// it ends after the standard ALC's.
+    ///
+    /// # Errors
+    /// As [`LearningLoop::new`].
+    pub fn with_user(
+        config: &LearnConfig,
+        experience: Option<&Experience>,
+        user: Box<dyn User>,
+    ) -> Result<Self, HarnessError> {
+        let mut setup = prepare(config)?;
+        let nominal = user.nominal(&setup)?;
+        setup.cover(
+            nominal.lane_change.end_s(),
+            config.planning.horizon_margin_s,
+        )?;
+        // The user's own lane change, driven, must not make it take over (its
+        // perceived-safety bound against its own gap acceptance).
+        if let Some((step, cause)) = judge(
+            &setup,
+            user.as_ref(),
+            &nominal,
+            &nominal.states[..=setup.horizon],
+        )? {
+            return Err(HarnessError::Scenario {
+                scenario: config.label(),
+                reason: format!(
+                    "user `{}` would take over its own lane change at step {step} ({cause:?})",
+                    user.name()
+                ),
+            });
+        }
         let options = aggregator_options(config);
         options.validate()?;
         let experience = starting_experience(config, &setup, experience)?;
@@ -96,18 +135,6 @@ impl LearningLoop {
             },
             ..config.planner.clone()
         })?;
-        let nominal = config.user.style()?;
-        let user = match config.user.spread {
-            Some(spread) => User::with_spread(nominal, spread)?,
-            None => User::deterministic(nominal)?,
-        };
-        let nominal_l = setup
-            .expected(&nominal)
-            .ok_or_else(|| HarnessError::Scenario {
-                scenario: config.label(),
-                reason: "the user does not change lanes within the horizon".to_owned(),
-            })?
-            .sample(setup.horizon, setup.dt);
         let fallback = if config.planning.safety.enforce {
             let standard = setup.standard_lane_change(&config.planning.standard_alc);
             let standard_weights =
@@ -146,12 +173,11 @@ impl LearningLoop {
             label: config.label(),
             method: config.method,
             stopping: config.stopping,
-            takeover_threshold_m: config.planning.takeover_threshold_m,
             options,
             setup,
             planner,
             user,
-            nominal_l,
+            nominal,
             template,
             experience,
             next_plan,
@@ -183,8 +209,8 @@ impl LearningLoop {
         if let Some(violation) = &refusal {
             observer.safety_refusal(index, violation);
         }
-        let drive = self.drive(plan)?;
-        let mut record = self.record(&drive);
+        let (drive, nominal_plan_taken_over) = self.drive(plan)?;
+        let mut record = self.record(&drive, nominal_plan_taken_over);
         record.planned_safety = planned_safety;
         record.safety_refusal = refusal;
         observer.lane_change(&record);
@@ -277,24 +303,35 @@ impl LearningLoop {
         }
     }
 
-    /// Draws the user of the next lane change and drives `plan` in the scene.
-    fn drive(&mut self, plan: Plan) -> Result<Drive, HarnessError> {
-        let style = self.user.next_style();
-        let expected = self
-            .setup
-            .expected(&style)
-            .ok_or_else(|| HarnessError::Scenario {
+    /// Asks the user for the next lane change (a user with spread draws anew),
+    /// drives `plan` in the scene, and judges the nominal lane change against the
+    /// same draw (the ceiling).
+    fn drive(&mut self, plan: Plan) -> Result<(Drive, bool), HarnessError> {
+        let expectation = self.user.next(&self.setup)?;
+        let horizon_s = self.setup.horizon as f64 * self.setup.dt;
+        if expectation.lane_change.end_s() > horizon_s + 1e-9 {
+            return Err(HarnessError::Scenario {
                 scenario: self.label.clone(),
                 reason: format!(
-                    "a drawn user (headway {:.3} s, duration {:.3} s) does not change lanes within the horizon",
-                    style.time_headway_s, style.lane_change_duration_s
+                    "a drawn lane change of user `{}` (start {:.3} s, duration {:.3} s) ends after the {horizon_s:.2} s horizon",
+                    self.user.name(),
+                    expectation.lane_change.start_s,
+                    expectation.lane_change.duration_s
                 ),
-            })?;
-        execute(&self.setup, plan, expected, self.takeover_threshold_m)
+            });
+        }
+        let ceiling = if self.user.has_spread() {
+            let nominal = &self.nominal.states[..=self.setup.horizon];
+            judge(&self.setup, self.user.as_ref(), &expectation, nominal)?.is_some()
+        } else {
+            false
+        };
+        let drive = execute(&self.setup, plan, self.user.as_ref(), &expectation)?;
+        Ok((drive, ceiling))
     }
 
     /// The record of a driven lane change.
-    fn record(&self, drive: &Drive) -> LaneChangeRecord {
+    fn record(&self, drive: &Drive, nominal_plan_taken_over: bool) -> LaneChangeRecord {
         LaneChangeRecord {
             index: self.records.len(),
             takeovers_before: self.takeovers,
@@ -307,12 +344,7 @@ impl LearningLoop {
             expected_l: drive.expected_l.clone(),
             driven_l: drive.driven.iter().map(|x| x.l).collect(),
             with_spread: self.user.has_spread(),
-            nominal_plan_taken_over: first_takeover(
-                &self.nominal_l,
-                &drive.expected_l,
-                self.takeover_threshold_m,
-            )
-            .is_some(),
+            nominal_plan_taken_over,
             safety: drive.safety,
             user_safety: drive.user_safety,
             planned_safety: SafetyMetrics::default(),
@@ -498,6 +530,7 @@ mod tests {
                 time_s: 1.0,
                 distance_m: 20.0,
                 deviation_m: 0.4,
+                cause: Default::default(),
             }),
             max_deviation_m: if taken { 0.4 } else { 0.1 },
             perceived_safety_ratio: if taken { 0.5 } else { 1.0 },

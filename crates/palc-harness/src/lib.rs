@@ -61,6 +61,7 @@ pub use safety::{SafetyConfig, SafetyMetrics, SafetyMonitor, Violation};
 pub use setup::{PlanningConfig, Setup};
 pub use standard_alc::StandardWeights;
 pub use user::StylePreset;
+pub use user::{Family, SimulatedUser, User};
 
 /// The loop's building blocks, for those who drive their own loop or test one
 /// part of it: the planning problem of a scenario, the execution of a plan with a
@@ -68,6 +69,6 @@ pub use user::StylePreset;
 /// [`LearningLoop`] composes them; most embedders need only that.
 pub mod advanced {
     pub use crate::acc::acc_leader;
-    pub use crate::drive::{Drive, execute, plan_safety, problem};
+    pub use crate::drive::{Drive, execute, judge, plan_safety, problem};
     pub use crate::method::{Driver, label};
 }

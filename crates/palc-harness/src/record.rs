@@ -4,6 +4,7 @@ use palc_aggregator::Timings;
 use serde::{Deserialize, Serialize};
 
 use crate::safety::{SafetyMetrics, Violation};
+use crate::user::TakeoverCause;
 
 /// Where and how the user took over.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -16,6 +17,9 @@ pub struct Takeover {
     pub distance_m: f64,
     /// `|planned − expected|` at the takeover (m).
     pub deviation_m: f64,
+    /// Why the user took over; the lateral deviation unless recorded otherwise.
+    #[serde(default)]
+    pub cause: TakeoverCause,
 }
 
 /// One lane change of the loop.

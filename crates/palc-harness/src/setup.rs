@@ -130,6 +130,8 @@ fn invalid(field: &str, value: f64, bound: &str) -> HarnessError {
 /// Everything the loop needs about one scenario, computed once at the trigger.
 #[derive(Debug, Clone)]
 pub struct Setup {
+    /// The scenario's label in messages, e.g. `collector-high / 40 m / seed 1 / neutral`.
+    pub label: String,
     /// The scene at the trigger; every lane change starts from a clone of it.
     pub scene: Scene,
     /// Time from the scene's start to the trigger (s).
@@ -153,9 +155,10 @@ pub struct Setup {
     pub origin_s: f64,
     /// What a user sees at each step `0..` of the search window, the ego keeping its lane.
     pub situations: Vec<Situation>,
-    /// Predicted preceding vehicle `(s − origin_s, l)` at steps `0..=K`.
+    /// Predicted preceding vehicle `(s − origin_s, l)` at steps `0..` of the
+    /// search window (plans read steps `0..=K`).
     pub preceding: Vec<[f64; 2]>,
-    /// Predicted adjacent vehicle `(s − origin_s, l)` at steps `0..=K`.
+    /// Predicted adjacent vehicle `(s − origin_s, l)` at steps `0..` of the search window.
     pub adjacent: Vec<[f64; 2]>,
     /// Start step of the standard ALC.
     pub standard_start_step: usize,
@@ -306,9 +309,8 @@ impl Setup {
                 "the horizon ({horizon} steps) exceeds the search window ({window} steps)"
             )));
         }
-        preceding.truncate(horizon + 1);
-        adjacent.truncate(horizon + 1);
         Ok(Setup {
+            label: label.to_owned(),
             scene,
             trigger_time_s,
             horizon,
@@ -331,23 +333,44 @@ impl Setup {
     /// the user would not start within the horizon.
     pub fn expected(&self, style: &Style) -> Option<ExpectedLaneChange> {
         let start = style.start_step(&self.situations[..=self.horizon])?;
-        let expected = ExpectedLaneChange {
-            start_s: start as f64 * self.dt,
-            duration_s: style.lane_change_duration_s,
-            from_l: 0.0,
-            to_l: self.target_l,
-        };
+        let expected = ExpectedLaneChange::quintic(
+            start as f64 * self.dt,
+            style.lane_change_duration_s,
+            0.0,
+            self.target_l,
+        );
         (expected.end_s() <= self.horizon as f64 * self.dt + 1e-9).then_some(expected)
     }
 
     /// The standard ALC's own lane change in this scenario.
     pub fn standard_lane_change(&self, standard: &Style) -> ExpectedLaneChange {
-        ExpectedLaneChange {
-            start_s: self.standard_start_step as f64 * self.dt,
-            duration_s: standard.lane_change_duration_s,
-            from_l: 0.0,
-            to_l: self.target_l,
+        ExpectedLaneChange::quintic(
+            self.standard_start_step as f64 * self.dt,
+            standard.lane_change_duration_s,
+            0.0,
+            self.target_l,
+        )
+    }
+
+    /// Extends the horizon so that it covers a lane change ending at `end_s` plus
+    /// `margin_s` (a user who changes lanes after the standard ALC). Never shortens it.
+    ///
+    /// # Errors
+    /// [`HarnessError::Scenario`] when that horizon exceeds the search window.
+    pub fn cover(&mut self, end_s: f64, margin_s: f64) -> Result<(), HarnessError> {
+        let needed = ((end_s + margin_s) / self.dt - 1e-9).ceil().max(0.0) as usize;
+        let window = self.situations.len().saturating_sub(1);
+        if needed > window {
+            return Err(HarnessError::Scenario {
+                scenario: self.label.clone(),
+                reason: format!(
+                    "a lane change ending at {end_s:.2} s needs a horizon of {needed} steps, \
+                     beyond the search window ({window} steps)"
+                ),
+            });
         }
+        self.horizon = self.horizon.max(needed);
+        Ok(())
     }
 
     /// Checks the paper's premise in this scenario: the standard ALC starts later and
@@ -439,7 +462,7 @@ fn lane_keeping_step(
 
 /// What a user sees in the scene: headway to the preceding vehicle, net gap to the
 /// nearest vehicle ahead on the target lane.
-fn situation(scene: &Scene) -> Situation {
+pub(crate) fn situation(scene: &Scene) -> Situation {
     let ego = scene.ego().map(|e| e.state).unwrap_or_default();
     let ego_speed = ego.v.max(1e-6);
     let headway_gap = scene
@@ -456,6 +479,8 @@ fn situation(scene: &Scene) -> Situation {
         .max_by(|a, b| a.state.s.total_cmp(&b.state.s));
     Situation {
         time_headway_s: headway_gap / ego_speed,
+        preceding_gap_m: headway_gap,
+        preceding_speed: scene.preceding().map(|p| p.state.v),
         target_lead_gap_m: lead.map(|v| v.rear() - ego.s),
         target_lag_gap_m: lag.map(|v| ego_rear - v.state.s),
         ego_speed,

@@ -97,6 +97,7 @@ fn a_user_with_spread_is_judged_against_the_nominal_ceiling() {
     config.user.spread = Some(palc_harness::user::Spread {
         relative: 0.02,
         seed: 11,
+        parameters: Default::default(),
     });
     let result = learn(&config);
     let summary = result.summary;

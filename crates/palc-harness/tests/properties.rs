@@ -1,7 +1,7 @@
 //! Property tests of the harness: perceived safety ratio and labelling.
 
 use palc_harness::advanced::{Driver, execute, label, problem};
-use palc_harness::user::{ExpectedLaneChange, first_takeover};
+use palc_harness::user::{ExpectedLaneChange, SimulatedUser, Style, User, first_takeover};
 use palc_harness::{LearnConfig, Method, prepare};
 use palc_planner::{Planner, PlannerConfig, Weights};
 use proptest::prelude::*;
@@ -28,8 +28,13 @@ proptest! {
             ..config.planner.clone()
         }).unwrap();
         let plan = planner.plan(&problem(&setup, weights, Vec::new())).unwrap();
-        let expected = ExpectedLaneChange { start_s: start, duration_s: duration, from_l: 0.0, to_l: 3.5 };
-        let drive = execute(&setup, plan, expected, 0.3).unwrap();
+        let user = SimulatedUser::paper(Style::NEUTRAL).unwrap();
+        let mut expectation = user.nominal(&setup).unwrap();
+        expectation.lane_change = ExpectedLaneChange::quintic(start, duration, 0.0, 3.5);
+        for (i, state) in expectation.states.iter_mut().enumerate() {
+            state.l = expectation.lane_change.lateral(i as f64 * setup.dt);
+        }
+        let drive = execute(&setup, plan, &user, &expectation).unwrap();
         prop_assert!((0.0..=1.0).contains(&drive.perceived_safety_ratio));
         prop_assert_eq!(drive.perceived_safety_ratio == 1.0, drive.takeover.is_none());
         // Who drove: the plan before the takeover, the user's expectation after it.

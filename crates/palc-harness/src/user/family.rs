@@ -1,0 +1,360 @@
+//! The built-in families of simulated users: how a user decides to start, how
+//! long it reacts, the shape of its lateral move, its speed during the lane
+//! change, and when it takes over for safety rather than for the path.
+//!
+//! A [`Family`] refines a [`Style`](crate::user::Style) (the paper's headway,
+//! duration and gap acceptance): its defaults are the paper's user, so an empty
+//! `[user.family]` table changes nothing. docs/paper-mapping.md ("User
+//! families") says why each rule is plausible for a human driver.
+
+use serde::{Deserialize, Serialize};
+
+use crate::HarnessError;
+use crate::user::profile::LateralProfile;
+use crate::user::situation::Situation;
+use crate::user::style::MAX_GAP_ACCEPTANCE_S;
+
+/// Bounds of the time-to-collision start threshold (s).
+pub const TTC_START_BOUNDS_S: (f64, f64) = (1.0, 30.0);
+/// Bounds of the distance-gap start threshold (m).
+pub const DISTANCE_START_BOUNDS_M: (f64, f64) = (2.0, 200.0);
+/// Largest reaction time (s): drivers' brake reaction times rarely exceed 2.5 s
+/// (Green, 2000); 3 s leaves room for a distracted driver.
+pub const MAX_REACTION_S: f64 = 3.0;
+/// Bounds of the acceleration towards the target lane's speed (m/s²): a driver
+/// who accelerates at all, and at most what a passenger car does at full throttle.
+pub const ACCELERATION_BOUNDS_MPS2: (f64, f64) = (0.1, 4.0);
+/// Bounds of the perceived-safety time gap (s).
+pub const COMFORT_TIME_GAP_BOUNDS_S: (f64, f64) = (0.1, 5.0);
+/// Bounds of the perceived-safety time to collision (s).
+pub const COMFORT_TTC_BOUNDS_S: (f64, f64) = (0.5, 20.0);
+/// Bounds of the lateral offset from which a user judges the target lane's gaps (m).
+pub const ONSET_BOUNDS_M: (f64, f64) = (0.05, 3.0);
+
+/// When a user decides to change lanes; gap acceptance on the target lane and
+/// the reaction time come after the decision.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(tag = "rule", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum StartRule {
+    /// The time headway to the preceding vehicle has fallen to the style's
+    /// `time_headway_s` (the paper's user).
+    #[default]
+    TimeHeadway,
+    /// The time to collision with the preceding vehicle has fallen to `seconds`.
+    TimeToCollision {
+        /// Threshold (s), in [`TTC_START_BOUNDS_S`].
+        seconds: f64,
+    },
+    /// The net distance gap to the preceding vehicle has fallen to `metres`.
+    DistanceGap {
+        /// Threshold (m), in [`DISTANCE_START_BOUNDS_M`].
+        metres: f64,
+    },
+}
+
+impl StartRule {
+    /// The rule's name in reports: `time-headway`, `time-to-collision`, `distance-gap`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            StartRule::TimeHeadway => "time-headway",
+            StartRule::TimeToCollision { .. } => "time-to-collision",
+            StartRule::DistanceGap { .. } => "distance-gap",
+        }
+    }
+
+    /// Whether the rule is met in `situation` for a style headway of
+    /// `time_headway_s`; never once the ego has reached the preceding vehicle.
+    pub fn decides(&self, situation: &Situation, time_headway_s: f64) -> bool {
+        situation.time_headway_s > 0.0
+            && match self {
+                StartRule::TimeHeadway => situation.time_headway_s <= time_headway_s,
+                StartRule::TimeToCollision { seconds } => situation.preceding_ttc_s() <= *seconds,
+                StartRule::DistanceGap { metres } => situation.preceding_gap_m <= *metres,
+            }
+    }
+
+    fn validate(&self, table: &str) -> Result<(), HarnessError> {
+        match *self {
+            StartRule::TimeHeadway => Ok(()),
+            StartRule::TimeToCollision { seconds } => {
+                within(&format!("{table}.seconds"), seconds, TTC_START_BOUNDS_S)
+            }
+            StartRule::DistanceGap { metres } => {
+                within(&format!("{table}.metres"), metres, DISTANCE_START_BOUNDS_M)
+            }
+        }
+    }
+}
+
+/// The user's speed during its lane change.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(tag = "rule", rename_all = "kebab-case", deny_unknown_fields)]
+pub enum SpeedRule {
+    /// The ego ACC's speed, as while keeping the lane (the paper's constant
+    /// speed when the ACC is off).
+    #[default]
+    Constant,
+    /// From the start, accelerate towards the target lane's speed (its leader's,
+    /// else its follower's) at most at `max_acceleration_mps2`, never faster than
+    /// the ACC allows behind the vehicle ahead.
+    Accelerating {
+        /// Largest acceleration (m/s²), in [`ACCELERATION_BOUNDS_MPS2`].
+        max_acceleration_mps2: f64,
+    },
+}
+
+impl SpeedRule {
+    /// The rule's name in reports: `constant` or `accelerating`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            SpeedRule::Constant => "constant",
+            SpeedRule::Accelerating { .. } => "accelerating",
+        }
+    }
+}
+
+/// The perceived-safety takeover rule: once the ego has moved `onset_m` towards
+/// the target lane, the user takes over when a target-lane vehicle is nearer
+/// than its comfort bound (as a time gap, or a time to collision), whatever the
+/// lateral deviation. This is what the paper's perceived safe zone exists to learn.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PerceivedSafety {
+    /// Smallest comfortable net gap to the target lane's leader (at the ego's
+    /// speed) or follower (at its speed), as a time gap (s).
+    pub min_time_gap_s: f64,
+    /// Smallest comfortable time to collision with either (s); `None` ignores it.
+    pub min_ttc_s: Option<f64>,
+    /// Lateral offset from the current lane's centre from which the user judges
+    /// the target lane's gaps (m); by default 0.5 m, where the move is visibly
+    /// under way but the ego's side has not yet reached the lane marking (at
+    /// 0.85 m for a 1.8 m wide car on a 3.5 m lane).
+    pub onset_m: f64,
+}
+
+impl Default for PerceivedSafety {
+    fn default() -> Self {
+        Self {
+            min_time_gap_s: 0.8,
+            min_ttc_s: None,
+            onset_m: 0.5,
+        }
+    }
+}
+
+impl PerceivedSafety {
+    /// Whether a user with this comfort bound is uncomfortable at `situation`
+    /// with the ego at `offset_m` towards the target lane; returns the gap and
+    /// time to collision that broke the bound, and which vehicle (`true` the leader).
+    pub fn breached(&self, offset_m: f64, situation: &Situation) -> Option<(bool, f64, f64)> {
+        if offset_m.abs() < self.onset_m {
+            return None;
+        }
+        let ttc_bound = self.min_ttc_s.unwrap_or(0.0);
+        let lead = situation.target_lead_times_s().map(|t| (true, t));
+        let lag = situation.target_lag_times_s().map(|t| (false, t));
+        [lead, lag]
+            .into_iter()
+            .flatten()
+            .find(|(_, (gap, ttc))| *gap < self.min_time_gap_s || *ttc < ttc_bound)
+            .map(|(lead, (gap, ttc))| (lead, gap, ttc))
+    }
+
+    fn validate(&self, table: &str) -> Result<(), HarnessError> {
+        within(
+            &format!("{table}.min_time_gap_s"),
+            self.min_time_gap_s,
+            COMFORT_TIME_GAP_BOUNDS_S,
+        )?;
+        if let Some(ttc) = self.min_ttc_s {
+            within(&format!("{table}.min_ttc_s"), ttc, COMFORT_TTC_BOUNDS_S)?;
+        }
+        within(&format!("{table}.onset_m"), self.onset_m, ONSET_BOUNDS_M)
+    }
+}
+
+/// A family of simulated users: the rules that refine a style. The default is
+/// the paper's user (time-headway start, no reaction delay, quintic profile,
+/// constant speed, takeover on lateral deviation only).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(default, deny_unknown_fields)]
+pub struct Family {
+    /// When the user decides to change lanes.
+    pub start: StartRule,
+    /// Delay between the decision and the earliest start (s), in `[0, MAX_REACTION_S]`.
+    pub reaction_s: f64,
+    /// Replaces the style's `min_lead_gap_s` (s).
+    pub min_lead_gap_s: Option<f64>,
+    /// Replaces the style's `min_lag_gap_s` (s).
+    pub min_lag_gap_s: Option<f64>,
+    /// The shape of the lateral move.
+    pub profile: LateralProfile,
+    /// The speed during the lane change.
+    pub speed: SpeedRule,
+    /// The perceived-safety takeover rule, besides the lateral deviation; none by default.
+    pub perceived_safety: Option<PerceivedSafety>,
+}
+
+impl Family {
+    /// A short description for reports, e.g. `time-to-collision start, cosine profile`.
+    pub fn describe(&self) -> String {
+        let mut parts = vec![format!("{} start", self.start.name())];
+        if self.reaction_s > 0.0 {
+            parts.push(format!("{} s reaction", self.reaction_s));
+        }
+        parts.push(format!("{} profile", self.profile.name()));
+        parts.push(format!("{} speed", self.speed.name()));
+        if self.perceived_safety.is_some() {
+            parts.push("perceived-safety takeover".to_owned());
+        }
+        parts.join(", ")
+    }
+
+    /// Checks every parameter against its bound, naming the field under `table`.
+    pub fn validate(&self, table: &str) -> Result<(), HarnessError> {
+        self.start.validate(&format!("{table}.start"))?;
+        within(
+            &format!("{table}.reaction_s"),
+            self.reaction_s,
+            (0.0, MAX_REACTION_S),
+        )?;
+        for (name, value) in [
+            ("min_lead_gap_s", self.min_lead_gap_s),
+            ("min_lag_gap_s", self.min_lag_gap_s),
+        ] {
+            if let Some(value) = value {
+                within(
+                    &format!("{table}.{name}"),
+                    value,
+                    (0.0, MAX_GAP_ACCEPTANCE_S),
+                )?;
+            }
+        }
+        self.profile.validate(&format!("{table}.profile"))?;
+        if let SpeedRule::Accelerating {
+            max_acceleration_mps2,
+        } = self.speed
+        {
+            within(
+                &format!("{table}.speed.max_acceleration_mps2"),
+                max_acceleration_mps2,
+                ACCELERATION_BOUNDS_MPS2,
+            )?;
+        }
+        if let Some(comfort) = &self.perceived_safety {
+            comfort.validate(&format!("{table}.perceived_safety"))?;
+        }
+        Ok(())
+    }
+}
+
+/// `Ok` when `value` is finite and in `[low, high]`, else the error naming `field`.
+pub(crate) fn within(field: &str, value: f64, (low, high): (f64, f64)) -> Result<(), HarnessError> {
+    if value.is_finite() && (low..=high).contains(&value) {
+        Ok(())
+    } else {
+        Err(HarnessError::InvalidConfig {
+            field: field.to_owned(),
+            value,
+            bound: format!("a value in [{low:?}, {high:?}]"),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn seen(headway: f64, lead_gap: f64, lag_gap: f64) -> Situation {
+        Situation {
+            time_headway_s: headway,
+            preceding_gap_m: headway * 20.0,
+            preceding_speed: Some(15.0),
+            target_lead_gap_m: Some(lead_gap),
+            target_lag_gap_m: Some(lag_gap),
+            ego_speed: 20.0,
+            target_lead_speed: Some(20.0),
+            target_lag_speed: Some(20.0),
+        }
+    }
+
+    #[test]
+    fn each_start_rule_reads_its_own_measure() {
+        // 1.2 s headway at 20 m/s: a 24 m gap closing at 5 m/s, TTC 4.8 s.
+        let s = seen(1.2, 50.0, 20.0);
+        assert!(StartRule::TimeHeadway.decides(&s, 1.23));
+        assert!(!StartRule::TimeHeadway.decides(&s, 1.1));
+        assert!(StartRule::TimeToCollision { seconds: 5.0 }.decides(&s, 0.0));
+        assert!(!StartRule::TimeToCollision { seconds: 4.5 }.decides(&s, 0.0));
+        assert!(StartRule::DistanceGap { metres: 25.0 }.decides(&s, 0.0));
+        assert!(!StartRule::DistanceGap { metres: 20.0 }.decides(&s, 0.0));
+        // Never behind a vehicle already reached.
+        let reached = seen(-0.1, 50.0, 20.0);
+        assert!(!StartRule::DistanceGap { metres: 25.0 }.decides(&reached, 0.0));
+    }
+
+    #[test]
+    fn perceived_safety_judges_gaps_only_once_the_move_is_under_way() {
+        let comfort = PerceivedSafety {
+            min_time_gap_s: 0.8,
+            min_ttc_s: None,
+            onset_m: 0.5,
+        };
+        let close_lag = seen(1.0, 50.0, 10.0); // 0.5 s behind at 20 m/s
+        assert_eq!(comfort.breached(0.2, &close_lag), None);
+        let (lead, gap, _) = comfort.breached(0.6, &close_lag).unwrap();
+        assert!(!lead && (gap - 0.5).abs() < 1e-12);
+        assert_eq!(comfort.breached(1.0, &seen(1.0, 50.0, 20.0)), None);
+    }
+
+    #[test]
+    fn out_of_range_parameters_name_their_field() {
+        let cases = [
+            (
+                Family {
+                    start: StartRule::TimeToCollision { seconds: 0.2 },
+                    ..Family::default()
+                },
+                "user.family.start.seconds",
+            ),
+            (
+                Family {
+                    reaction_s: 4.0,
+                    ..Family::default()
+                },
+                "user.family.reaction_s",
+            ),
+            (
+                Family {
+                    speed: SpeedRule::Accelerating {
+                        max_acceleration_mps2: f64::NAN,
+                    },
+                    ..Family::default()
+                },
+                "user.family.speed.max_acceleration_mps2",
+            ),
+            (
+                Family {
+                    perceived_safety: Some(PerceivedSafety {
+                        min_ttc_s: Some(100.0),
+                        ..PerceivedSafety::default()
+                    }),
+                    ..Family::default()
+                },
+                "user.family.perceived_safety.min_ttc_s",
+            ),
+            (
+                Family {
+                    min_lag_gap_s: Some(-1.0),
+                    ..Family::default()
+                },
+                "user.family.min_lag_gap_s",
+            ),
+        ];
+        for (family, field) in cases {
+            let err = family.validate("user.family").unwrap_err().to_string();
+            assert!(err.contains(field), "{err}");
+        }
+        Family::default().validate("user.family").unwrap();
+    }
+}
