@@ -37,6 +37,8 @@ enum Command {
     Plan(commands::plan::PlanArgs),
     /// The perceived safe zone filter: fit on labelled samples, classify points.
     Zone(commands::zone::ZoneArgs),
+    /// Simulated users: the lane change a user expects, before learning starts.
+    User(commands::user::UserArgs),
 }
 
 fn main() -> ExitCode {
@@ -47,6 +49,7 @@ fn main() -> ExitCode {
         Command::Traffic(args) => commands::traffic::run(args),
         Command::Plan(args) => commands::plan::run(args),
         Command::Zone(args) => commands::zone::run(args),
+        Command::User(args) => commands::user::run(args),
     };
     let result = result.and_then(|()| match console::failure() {
         Some(error) => Err(anyhow::Error::new(error).context("cannot write to the terminal")),

@@ -13,7 +13,8 @@
 
 use std::path::{Path, PathBuf};
 
-use palc_harness::{Method, StylePreset};
+use palc_harness::user::ParameterSpread;
+use palc_harness::{Family, Method, StylePreset};
 use palc_traffic::{SpeedCaseConfig, TestbedConfig};
 use serde::{Deserialize, Serialize};
 
@@ -87,6 +88,15 @@ pub struct UserKind {
     /// for a deterministic user.
     #[serde(default)]
     pub spread_relative: Option<f64>,
+    /// Spread of other parameters (`palc_harness::user::ParameterSpread`); the
+    /// draws are seeded with the scene's seed.
+    #[serde(default)]
+    pub spread_parameters: Option<ParameterSpread>,
+    /// The family that refines each style (`palc_harness::Family`: start rule,
+    /// reaction, lateral profile, speed, perceived-safety takeover); the paper's
+    /// user when left out.
+    #[serde(default)]
+    pub family: Option<Family>,
 }
 
 impl UserKind {
@@ -95,7 +105,22 @@ impl UserKind {
         UserKind {
             name: "deterministic".to_owned(),
             spread_relative: None,
+            spread_parameters: None,
+            family: None,
         }
+    }
+
+    /// Whether this kind departs from the paper's user model beyond the spread
+    /// of headway and duration: a family, or spread on other parameters. The
+    /// report gives such kinds one row each in its user-family table, and the
+    /// paper's kinds a section each.
+    pub fn is_family(&self) -> bool {
+        self.family.is_some() || self.spread_parameters.is_some()
+    }
+
+    /// Whether any parameter is drawn per lane change.
+    pub fn has_spread(&self) -> bool {
+        self.spread_relative.is_some() || self.spread_parameters.is_some()
     }
 }
 
@@ -272,6 +297,16 @@ impl EvalConfig {
                         "a value in [0, 0.5)",
                     ));
                 }
+            }
+            if let Some(family) = &user.family {
+                family
+                    .validate(&format!("users[{i}].family"))
+                    .map_err(|source| EvalError::invalid_user(source))?;
+            }
+            if let Some(parameters) = &user.spread_parameters {
+                parameters
+                    .validate(&format!("users[{i}].spread_parameters"))
+                    .map_err(|source| EvalError::invalid_user(source))?;
             }
             if self.users[..i].iter().any(|u| u.name == user.name) {
                 return Err(EvalError::invalid(

@@ -94,6 +94,23 @@ pub enum EvalError {
 }
 
 impl EvalError {
+    /// A user kind's invalid family or spread, as an error of the evaluation
+    /// config (the field path already names `users[i]`).
+    pub(crate) fn invalid_user(source: palc_harness::HarnessError) -> EvalError {
+        match source {
+            palc_harness::HarnessError::InvalidConfig {
+                field,
+                value,
+                bound,
+            } => EvalError::InvalidConfig {
+                field,
+                value: format!("{value:e}"),
+                bound,
+            },
+            other => EvalError::Harness(other),
+        }
+    }
+
     /// Adds the path of the file the error is in.
     pub fn in_file(self, path: impl Into<PathBuf>) -> EvalError {
         EvalError::InFile {

@@ -8,7 +8,7 @@
 use std::time::Instant;
 
 use palc_aggregator::Experience;
-use palc_harness::user::Spread;
+use palc_harness::user::{Spread, TakeoverCause};
 use palc_harness::{
     CellChoice, HarnessError, LaneChangeRecord, LearnConfig, LessonEvent, Observer, Outcome,
     RunResult, UserConfig,
@@ -50,10 +50,12 @@ impl HarnessRuns {
     /// user and (timing experiment) step and horizon margin.
     pub fn config(&self, spec: &RunSpec) -> Result<LearnConfig, EvalError> {
         let user = UserConfig {
-            spread: spec.user.spread_relative.map(|relative| Spread {
-                relative,
+            spread: spec.user.has_spread().then(|| Spread {
+                relative: spec.user.spread_relative.unwrap_or(0.0),
                 seed: spec.seed,
+                parameters: spec.user.spread_parameters.unwrap_or_default(),
             }),
+            family: spec.user.family.clone(),
             ..UserConfig::preset(spec.style)
         };
         let mut config = (self.base.clone())
@@ -173,6 +175,9 @@ impl Observer for RowRecorder {
     fn lane_change(&mut self, record: &LaneChangeRecord) {
         self.iterations.push(Iteration {
             takeover: record.takeover.is_some(),
+            perceived_safety_takeover: record
+                .takeover
+                .is_some_and(|t| matches!(t.cause, TakeoverCause::PerceivedSafety { .. })),
             perceived_safety_ratio: record.perceived_safety_ratio,
             max_deviation_m: record.max_deviation_m,
             times_s: record.times.parts(),

@@ -36,6 +36,7 @@ mod error;
 #[cfg(feature = "plot")]
 mod experiments;
 #[cfg(feature = "plot")]
+pub mod families_report;
 pub mod figures;
 pub mod harness_runs;
 pub mod manifest;
@@ -233,7 +234,12 @@ pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcom
         &out.join("manifest.json"),
         &serde_json::to_string_pretty(&manifest)?,
     )?;
-    let user_names: Vec<String> = selection.users.iter().map(|u| u.name.clone()).collect();
+    // The paper's user kinds get a section and figures each; the families one
+    // table together.
+    let user_names: Vec<String> = (selection.users.iter())
+        .filter(|u| !u.is_family())
+        .map(|u| u.name.clone())
+        .collect();
     #[cfg(feature = "plot")]
     let figures = experiments::draw_all(
         &rows,
@@ -248,6 +254,7 @@ pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcom
         rows: &rows,
         methods: &selection.grid.methods,
         users: &user_names,
+        user_kinds: &selection.users,
         example: example.as_ref().map_err(Clone::clone),
         figures: &figures,
         manifest: &manifest,

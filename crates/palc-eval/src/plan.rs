@@ -277,6 +277,7 @@ pub(crate) mod tests {
                 UserKind {
                     name: "spread".into(),
                     spread_relative: Some(0.02),
+                    ..UserKind::deterministic()
                 },
             ],
             transfer: TransferConfig {

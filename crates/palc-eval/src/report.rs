@@ -19,8 +19,10 @@ pub struct ReportInput<'a> {
     pub rows: &'a [RunRow],
     /// Methods in report order.
     pub methods: &'a [Method],
-    /// User kinds in report order.
+    /// The paper's user kinds (no family), in report order: a section each.
     pub users: &'a [String],
+    /// Every user kind of the selection: the user-family table.
+    pub user_kinds: &'a [crate::config::UserKind],
     /// The example run, or why it is missing.
     pub example: Result<&'a ExampleTrace, String>,
     /// The figures written.
@@ -60,6 +62,7 @@ pub fn render(input: &ReportInput) -> String {
     for user in input.users {
         user_section(&mut out, input, user);
     }
+    crate::families_report::section(&mut out, input.rows, input.methods, input.user_kinds);
     claims_section(&mut out);
     crate::safety_report::section(&mut out, input.rows, input.methods);
     refusals(&mut out, input.rows);
@@ -544,6 +547,7 @@ mod tests {
             rows: &rows,
             methods: &methods,
             users: &users,
+            user_kinds: &[],
             example: Err("not run in this test".into()),
             figures: &[],
             manifest: &manifest,

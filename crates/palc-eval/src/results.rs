@@ -51,6 +51,9 @@ impl Status {
 pub struct Iteration {
     /// Whether the user took over.
     pub takeover: bool,
+    /// Whether it took over on its perceived-safety bound (not the lateral deviation).
+    #[serde(default)]
+    pub perceived_safety_takeover: bool,
     /// Perceived safety distance ratio (1 without takeover).
     pub perceived_safety_ratio: f64,
     /// Largest `|planned − expected|` (m).

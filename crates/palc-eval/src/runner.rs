@@ -177,6 +177,7 @@ pub(crate) mod tests {
             let iterations = (0..lane_changes)
                 .map(|i| Iteration {
                     takeover: i < takeovers,
+                    perceived_safety_takeover: false,
                     perceived_safety_ratio: if i < takeovers {
                         0.2 + 0.5 * i as f64 / lane_changes as f64
                     } else {

@@ -51,7 +51,9 @@ fn subset(evaluation: &Evaluation) -> Selection {
     selection.grid.headways_m = vec![40.0];
     selection.grid.styles = vec![StylePreset::Aggressive, StylePreset::Cautious];
     selection.grid.seeds = vec![1];
-    selection.users.retain(|u| u.spread_relative.is_none());
+    selection
+        .users
+        .retain(|u| !u.has_spread() && !u.is_family());
     selection.transfer = TransferConfig {
         source: TransferSource::NextSpeedCase,
         users: selection.users.iter().map(|u| u.name.clone()).collect(),

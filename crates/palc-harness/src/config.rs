@@ -72,7 +72,22 @@ pub struct UserConfig {
     pub spread: Option<Spread>,
 }
 
+/// A file holding only a `[user]` table (`palc learn --user FILE`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct UserFile {
+    user: UserConfig,
+}
+
 impl UserConfig {
+    /// Parses and checks a TOML text holding one `[user]` table (and nothing
+    /// else), e.g. a user family kept in its own file; errors name the field path.
+    pub fn from_toml_str(text: &str, deviation_m: f64) -> Result<UserConfig, HarnessError> {
+        let file: UserFile = from_toml(text)?;
+        file.user.simulated(deviation_m)?;
+        Ok(file.user)
+    }
+
     /// A deterministic user of one of the paper's styles.
     pub fn preset(preset: StylePreset) -> UserConfig {
         UserConfig {

@@ -13,7 +13,7 @@ use crate::method::Method;
 use crate::observer::Observer;
 use crate::record::{LaneChangeRecord, RunSummary};
 use crate::setup::Setup;
-use crate::user::StylePreset;
+use crate::user::{Expectation, StylePreset, User};
 
 /// Everything a run produced.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -60,6 +60,34 @@ pub fn prepare(config: &LearnConfig) -> Result<Setup, HarnessError> {
             reason,
         })?;
     Ok(setup)
+}
+
+/// The scenario of `config` with its user's nominal expected lane change: what a
+/// user wants before learning starts (`palc user expect`). The horizon covers the
+/// lane change, as in [`LearningLoop::new`].
+///
+/// # Errors
+/// As [`prepare`], or a user without a sane lane change in the scenario.
+pub fn expectation(config: &LearnConfig) -> Result<(Setup, Expectation), HarnessError> {
+    let user = config
+        .user
+        .simulated(config.planning.takeover_threshold_m)?;
+    prepare_for(config, &user)
+}
+
+/// [`prepare`], then the user's nominal lane change, with the horizon extended to
+/// cover it (a user who ends after the standard ALC).
+pub(crate) fn prepare_for(
+    config: &LearnConfig,
+    user: &dyn User,
+) -> Result<(Setup, Expectation), HarnessError> {
+    let mut setup = prepare(config)?;
+    let nominal = user.nominal(&setup)?;
+    setup.cover(
+        nominal.lane_change.end_s(),
+        config.planning.horizon_margin_s,
+    )?;
+    Ok((setup, nominal))
 }
 
 /// Runs the lesson-learning loop of `config`, starting from `experience` if given:

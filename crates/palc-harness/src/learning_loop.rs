@@ -15,7 +15,7 @@ use palc_planner::{LateralBoundsMode, Plan, Planner, PlannerConfig, Problem};
 use crate::HarnessError;
 use crate::config::{LearnConfig, StoppingConfig};
 use crate::drive::{Drive, execute, judge, plan_safety, problem};
-use crate::learn::{RunResult, aggregator_options, prepare};
+use crate::learn::{RunResult, aggregator_options, prepare_for};
 use crate::lesson::{lesson, scenes, zone_feature_set};
 use crate::method::Method;
 use crate::observer::{LessonEvent, Observer};
@@ -71,7 +71,7 @@ pub struct LearningLoop {
 
 impl LearningLoop {
     /// Prepares the run of `config`: builds and checks the scenario
-    /// ([`prepare`]), the planner, the simulated user and the first plan, starting
+    /// ([`crate::prepare`]), the planner, the simulated user and the first plan, starting
     /// from `experience` if given (its weights resampled to this scenario's horizon
     /// and step), else from the standard ALC's weights.
     ///
@@ -101,12 +101,7 @@ impl LearningLoop {
         experience: Option<&Experience>,
         user: Box<dyn User>,
     ) -> Result<Self, HarnessError> {
-        let mut setup = prepare(config)?;
-        let nominal = user.nominal(&setup)?;
-        setup.cover(
-            nominal.lane_change.end_s(),
-            config.planning.horizon_margin_s,
-        )?;
+        let (setup, nominal) = prepare_for(config, user.as_ref())?;
         // The user's own lane change, driven, must not make it take over (its
         // perceived-safety bound against its own gap acceptance).
         if let Some((step, cause)) = judge(

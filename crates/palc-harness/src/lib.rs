@@ -51,7 +51,7 @@ pub use config::{
     UserConfig, UserStyle,
 };
 pub use error::HarnessError;
-pub use learn::{RunResult, aggregator_options, prepare, run};
+pub use learn::{RunResult, aggregator_options, expectation, prepare, run};
 pub use learning_loop::LearningLoop;
 pub use method::Method;
 pub use observer::{LessonEvent, NoObserver, Observer};

@@ -9,7 +9,7 @@
 //! a margin, so that no user's lane change ends after the terminal condition pins
 //! the lateral position.
 
-use palc_traffic::{EgoState, Lane, Scene, ballistic_step};
+use palc_traffic::{Driver, EgoState, Lane, Scene, ballistic_step};
 use serde::{Deserialize, Serialize};
 
 use crate::HarnessError;
@@ -469,7 +469,9 @@ pub(crate) fn situation(scene: &Scene) -> Situation {
         .preceding()
         .map_or(f64::INFINITY, |p| p.rear() - ego.s);
     let ego_rear = scene.ego().map_or(ego.s, |e| e.rear());
-    let target_lane = scene.vehicles().iter().filter(|v| v.lane == Lane(1));
+    // The ego itself is on the target lane once it has moved over: not its own lag.
+    let target_lane = (scene.vehicles().iter())
+        .filter(|v| v.lane == Lane(1) && !matches!(v.driver, Driver::External { .. }));
     let lead = target_lane
         .clone()
         .filter(|v| v.state.s > ego.s)

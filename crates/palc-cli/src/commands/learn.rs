@@ -1,6 +1,6 @@
 //! `palc learn`: runs the lesson-learning loop and shows each lane change.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Context;
 use clap::Args;
@@ -15,15 +15,19 @@ use crate::console::say;
 /// The default config, compiled in so that `palc learn` alone works anywhere.
 const DEFAULT_CONFIG: &str = include_str!("../../../../configs/learn.toml");
 
-/// Arguments of `palc learn`.
+/// The scenario and user of a run: a config and what the command line overrides.
 #[derive(Debug, Args)]
-pub struct LearnArgs {
+pub struct ScenarioArgs {
     /// Run config (TOML); the paper's test bed and the `palc` method by default.
     #[arg(long)]
     config: Option<PathBuf>,
     /// Learning method: `paper` or `palc`.
     #[arg(long)]
     method: Option<String>,
+    /// A TOML file holding a `[user]` table (style, `[user.family]`, `[user.spread]`)
+    /// that replaces the config's.
+    #[arg(long)]
+    user: Option<PathBuf>,
     /// Driving style: `aggressive`, `neutral`, `cautious`, or `custom` for the
     /// config's `[user.custom]` table.
     #[arg(long)]
@@ -37,6 +41,13 @@ pub struct LearnArgs {
     /// Seed of the scene.
     #[arg(long)]
     seed: Option<u64>,
+}
+
+/// Arguments of `palc learn`.
+#[derive(Debug, Args)]
+pub struct LearnArgs {
+    #[command(flatten)]
+    scenario: ScenarioArgs,
     /// Start from experience saved in another run.
     #[arg(long)]
     experience: Option<PathBuf>,
@@ -46,6 +57,52 @@ pub struct LearnArgs {
     /// Write every lane change (trajectories, timings) as JSON.
     #[arg(long)]
     record: Option<PathBuf>,
+}
+
+/// Reads a file for a command, naming it in the error.
+fn read(path: &Path) -> anyhow::Result<String> {
+    std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+}
+
+/// The learning config of `args`: the config file (or the built-in one) with the
+/// user file, method, style and cell of the command line.
+pub fn load_config(args: &ScenarioArgs) -> anyhow::Result<LearnConfig> {
+    let (text, source) = match &args.config {
+        Some(path) => (read(path)?, path.display().to_string()),
+        None => (
+            DEFAULT_CONFIG.to_owned(),
+            "the built-in configs/learn.toml".to_owned(),
+        ),
+    };
+    let mut config = LearnConfig::from_toml_str(&text).with_context(|| format!("in {source}"))?;
+    if let Some(name) = &args.method {
+        let method = Method::named(name)
+            .with_context(|| format!("unknown method `{name}`: expected `paper` or `palc`"))?;
+        config = config.with_method(method);
+    }
+    if let Some(path) = &args.user {
+        let user = UserConfig::from_toml_str(&read(path)?, config.planning.takeover_threshold_m)
+            .with_context(|| format!("in {}", path.display()))?;
+        config = config.with_user(user);
+    }
+    if let Some(style) = args.style {
+        let user = UserConfig {
+            style,
+            ..config.user.clone()
+        };
+        config = config.with_user(user);
+    }
+    let cell = CellChoice {
+        speed_case: args
+            .speed
+            .clone()
+            .unwrap_or_else(|| config.cell.speed_case.clone()),
+        headway_m: args.headway.unwrap_or(config.cell.headway_m),
+        seed: args.seed.unwrap_or(config.cell.seed),
+    };
+    let config = config.with_cell(cell);
+    config.validate().with_context(|| format!("in {source}"))?;
+    Ok(config)
 }
 
 /// Prints one line per lane change as it happens.
@@ -95,36 +152,7 @@ impl Observer for Printer {
 
 /// Runs `palc learn`.
 pub fn run_learn(args: LearnArgs) -> anyhow::Result<()> {
-    let (text, source) = match &args.config {
-        Some(path) => (
-            std::fs::read_to_string(path)
-                .with_context(|| format!("cannot read {}", path.display()))?,
-            path.display().to_string(),
-        ),
-        None => (
-            DEFAULT_CONFIG.to_owned(),
-            "the built-in configs/learn.toml".to_owned(),
-        ),
-    };
-    let mut config = LearnConfig::from_toml_str(&text).with_context(|| format!("in {source}"))?;
-    if let Some(name) = &args.method {
-        let method = Method::named(name)
-            .with_context(|| format!("unknown method `{name}`: expected `paper` or `palc`"))?;
-        config = config.with_method(method);
-    }
-    if let Some(style) = args.style {
-        let user = UserConfig {
-            style,
-            ..config.user.clone()
-        };
-        config = config.with_user(user);
-    }
-    let cell = CellChoice {
-        speed_case: args.speed.unwrap_or_else(|| config.cell.speed_case.clone()),
-        headway_m: args.headway.unwrap_or(config.cell.headway_m),
-        seed: args.seed.unwrap_or(config.cell.seed),
-    };
-    let config = config.with_cell(cell);
+    let config = load_config(&args.scenario)?;
     let experience = match &args.experience {
         Some(path) => Some(
             Experience::load(path).with_context(|| format!("cannot load {}", path.display()))?,

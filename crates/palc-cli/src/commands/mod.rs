@@ -4,4 +4,5 @@ pub mod eval;
 pub mod learn;
 pub mod plan;
 pub mod traffic;
+pub mod user;
 pub mod zone;

@@ -122,19 +122,22 @@ pub struct TakeoverRule {
 
 impl TakeoverRule {
     /// Whether the user takes over at a step where the ego is at `ego_l`, the user
-    /// expected `expected_l` and sees `seen`; the deviation rule first.
+    /// expected `expected_l` and sees `seen`, in a lane change from `from_l` to
+    /// `to_l`; the deviation rule first.
     pub fn judge(
         &self,
         ego_l: f64,
         expected_l: f64,
-        from_l: f64,
+        (from_l, to_l): (f64, f64),
         seen: &Situation,
     ) -> Option<TakeoverCause> {
         if (ego_l - expected_l).abs() > self.deviation_m {
             return Some(TakeoverCause::Deviation);
         }
         let comfort = self.perceived_safety?;
-        let (lead, gap, ttc) = comfort.breached(ego_l - from_l, seen)?;
+        let direction = (to_l - from_l).signum();
+        let (lead, gap, ttc) =
+            comfort.breached((ego_l - from_l) * direction, (to_l - from_l).abs(), seen)?;
         Some(TakeoverCause::PerceivedSafety {
             lead,
             time_gap_s: gap.is_finite().then_some(gap),

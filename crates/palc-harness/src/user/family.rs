@@ -28,6 +28,9 @@ pub const ACCELERATION_BOUNDS_MPS2: (f64, f64) = (0.1, 4.0);
 pub const COMFORT_TIME_GAP_BOUNDS_S: (f64, f64) = (0.1, 5.0);
 /// Bounds of the perceived-safety time to collision (s).
 pub const COMFORT_TTC_BOUNDS_S: (f64, f64) = (0.5, 20.0);
+/// Distance from the target lane's centre within which the lane change is over (m):
+/// the 5 cm by which the harness finds the end of a driven lane change.
+pub const SETTLED_M: f64 = 0.05;
 /// Bounds of the lateral offset from which a user judges the target lane's gaps (m).
 pub const ONSET_BOUNDS_M: (f64, f64) = (0.05, 3.0);
 
@@ -113,10 +116,13 @@ impl SpeedRule {
     }
 }
 
-/// The perceived-safety takeover rule: once the ego has moved `onset_m` towards
-/// the target lane, the user takes over when a target-lane vehicle is nearer
+/// The perceived-safety takeover rule: during the lane change (from `onset_m`
+/// towards the target lane until the ego has settled within [`SETTLED_M`] of the
+/// target lane's centre), the user takes over when a target-lane vehicle is nearer
 /// than its comfort bound (as a time gap, or a time to collision), whatever the
 /// lateral deviation. This is what the paper's perceived safe zone exists to learn.
+/// Once settled, the ego follows in its new lane: the ACC's concern, measured by
+/// the safety metrics, not the lane change the user judges.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct PerceivedSafety {
@@ -144,10 +150,16 @@ impl Default for PerceivedSafety {
 
 impl PerceivedSafety {
     /// Whether a user with this comfort bound is uncomfortable at `situation`
-    /// with the ego at `offset_m` towards the target lane; returns the gap and
-    /// time to collision that broke the bound, and which vehicle (`true` the leader).
-    pub fn breached(&self, offset_m: f64, situation: &Situation) -> Option<(bool, f64, f64)> {
-        if offset_m.abs() < self.onset_m {
+    /// with the ego at `offset_m` towards the target lane, `width_m` away; returns
+    /// the gap and time to collision that broke the bound, and which vehicle
+    /// (`true` the leader).
+    pub fn breached(
+        &self,
+        offset_m: f64,
+        width_m: f64,
+        situation: &Situation,
+    ) -> Option<(bool, f64, f64)> {
+        if offset_m < self.onset_m || width_m - offset_m < SETTLED_M {
             return None;
         }
         let ttc_bound = self.min_ttc_s.unwrap_or(0.0);
@@ -301,10 +313,12 @@ mod tests {
             onset_m: 0.5,
         };
         let close_lag = seen(1.0, 50.0, 10.0); // 0.5 s behind at 20 m/s
-        assert_eq!(comfort.breached(0.2, &close_lag), None);
-        let (lead, gap, _) = comfort.breached(0.6, &close_lag).unwrap();
+        assert_eq!(comfort.breached(0.2, 3.5, &close_lag), None);
+        let (lead, gap, _) = comfort.breached(0.6, 3.5, &close_lag).unwrap();
         assert!(!lead && (gap - 0.5).abs() < 1e-12);
-        assert_eq!(comfort.breached(1.0, &seen(1.0, 50.0, 20.0)), None);
+        assert_eq!(comfort.breached(1.0, 3.5, &seen(1.0, 50.0, 20.0)), None);
+        // Settled on the target lane: the lane change is over.
+        assert_eq!(comfort.breached(3.47, 3.5, &close_lag), None);
     }
 
     #[test]

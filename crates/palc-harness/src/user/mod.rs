@@ -41,14 +41,14 @@ pub use expectation::{
 };
 pub use family::{
     ACCELERATION_BOUNDS_MPS2, COMFORT_TIME_GAP_BOUNDS_S, COMFORT_TTC_BOUNDS_S,
-    DISTANCE_START_BOUNDS_M, Family, MAX_REACTION_S, ONSET_BOUNDS_M, PerceivedSafety, SpeedRule,
-    StartRule, TTC_START_BOUNDS_S,
+    DISTANCE_START_BOUNDS_M, Family, MAX_REACTION_S, ONSET_BOUNDS_M, PerceivedSafety, SETTLED_M,
+    SpeedRule, StartRule, TTC_START_BOUNDS_S,
 };
 pub use profile::{
     LateralProfile, MAX_TABLE_POINTS, PEAK_FRACTION_BOUNDS, ProfilePoint, TABLE_END_TOLERANCE_M,
     quintic,
 };
-pub use simulated::SimulatedUser;
+pub use simulated::{MAX_DRAWS, SimulatedUser};
 pub use situation::Situation;
 pub use spread::{Draw, MAX_ABSOLUTE_SPREAD, MAX_RELATIVE_SPREAD, ParameterSpread, Spread};
 pub use style::{MAX_GAP_ACCEPTANCE_S, Style, StylePreset};
@@ -124,9 +124,13 @@ pub trait User: std::fmt::Debug {
         seen: &Situation,
     ) -> Option<TakeoverCause> {
         let expected_l = expectation.states.get(step).map_or(ego.l, |x| x.l);
-        expectation
-            .takeover
-            .judge(ego.l, expected_l, expectation.lane_change.from_l, seen)
+        let lane_change = &expectation.lane_change;
+        expectation.takeover.judge(
+            ego.l,
+            expected_l,
+            (lane_change.from_l, lane_change.to_l),
+            seen,
+        )
     }
 
     /// The user's longitudinal acceleration at `step` after a takeover, driving

@@ -11,10 +11,10 @@
 //! - **cosine**, `p = (1 − cos πτ) / 2`: a half-sine lateral speed, the
 //!   lane-change model of Nelson (1989) and of many driver models; its lateral
 //!   acceleration steps at both ends.
-//! - **asymmetric**, lateral speed `∝ τᵃ (1 − τ)ᵇ` with its peak at
-//!   `τ = a / (a + b) = peak_fraction`, `min(a, b) = 2`: a driver who moves
-//!   briskly early (or late) and settles gently; `peak_fraction = 0.5` is the
-//!   quintic exactly (`a = b = 2`).
+//! - **asymmetric**, the quintic's accelerating half over `[0, p]` and its
+//!   decelerating half over `[p, 1]`, `p = peak_fraction`: the lateral speed
+//!   peaks at `p` (early or late), position, speed and acceleration stay
+//!   continuous; `p = 0.5` is the quintic exactly.
 //! - **table**: `(time since start, lateral offset)` points, e.g. recorded from a
 //!   driver or another simulator, interpolated by the monotone piecewise cubic
 //!   of Fritsch and Carlson (1980): monotone data stays monotone, no overshoot.
@@ -25,7 +25,8 @@ use serde::{Deserialize, Serialize};
 use crate::HarnessError;
 
 /// Smallest and largest `peak_fraction` of the asymmetric profile.
-pub const PEAK_FRACTION_BOUNDS: (f64, f64) = (0.2, 0.8);
+/// At the bounds the peak lateral acceleration is 1.67 times the quintic's.
+pub const PEAK_FRACTION_BOUNDS: (f64, f64) = (0.3, 0.7);
 /// Most points of a table profile: a minute of samples at 100 Hz.
 pub const MAX_TABLE_POINTS: usize = 6_000;
 /// Largest gap between the table's last offset and the lane change's offset (m):
@@ -51,7 +52,7 @@ pub enum LateralProfile {
     Quintic,
     /// Half-sine lateral speed, `(1 − cos πτ) / 2`.
     Cosine,
-    /// Lateral speed `∝ τᵃ (1 − τ)ᵇ`, peaking at `peak_fraction` of the duration.
+    /// Two half-quintics, the lateral speed peaking at `peak_fraction` of the duration.
     Asymmetric {
         /// Where the lateral speed peaks, as a fraction of the duration, in
         /// [`PEAK_FRACTION_BOUNDS`]; 0.5 is the quintic.
@@ -188,55 +189,18 @@ pub fn quintic(tau: f64) -> f64 {
     t * t * t * (10.0 + t * (-15.0 + 6.0 * t))
 }
 
-/// Gauss–Legendre nodes and weights on `[-1, 1]` (8 points: exact for polynomials
-/// of degree 15, so for every integer-exponent speed profile up to `a + b = 15`;
-/// the non-integer ones are smooth enough for 1e-9 over the 16 panels used below).
-const GAUSS_8: [(f64, f64); 8] = [
-    (-0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
-    (-0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
-    (-0.525_532_409_916_329, 0.313_706_645_877_887_3),
-    (-0.183_434_642_495_649_8, 0.362_683_783_378_362),
-    (0.183_434_642_495_649_8, 0.362_683_783_378_362),
-    (0.525_532_409_916_329, 0.313_706_645_877_887_3),
-    (0.796_666_477_413_626_7, 0.222_381_034_453_374_47),
-    (0.960_289_856_497_536_3, 0.101_228_536_290_376_26),
-];
-
-/// Panels of the quadrature of the asymmetric profile.
-const ASYMMETRIC_PANELS: usize = 16;
-
-/// Exponents `(a, b)` of the asymmetric speed `τᵃ (1 − τ)ᵇ` peaking at `peak`:
-/// `a / (a + b) = peak` with the smaller exponent 2 (zero acceleration and bounded
-/// jerk at both ends, as the quintic's).
-fn asymmetric_exponents(peak: f64) -> (f64, f64) {
-    let smaller = peak.min(1.0 - peak);
-    (2.0 * peak / smaller, 2.0 * (1.0 - peak) / smaller)
-}
-
-/// `∫₀^τ sᵃ (1 − s)ᵇ ds` by composite Gauss–Legendre quadrature.
-fn speed_integral(tau: f64, a: f64, b: f64) -> f64 {
-    let width = tau / ASYMMETRIC_PANELS as f64;
-    (0..ASYMMETRIC_PANELS)
-        .map(|panel| {
-            let mid = (panel as f64 + 0.5) * width;
-            GAUSS_8
-                .iter()
-                .map(|(x, w)| {
-                    let s = mid + 0.5 * width * x;
-                    w * s.powf(a) * (1.0 - s).powf(b)
-                })
-                .sum::<f64>()
-                * 0.5
-                * width
-        })
-        .sum()
-}
-
-/// Progress of the asymmetric profile: the normalized integral of its speed.
+/// Progress of the asymmetric profile: the accelerating half of a quintic
+/// stretched over `[0, p]` and its decelerating half over `[p, 1]`, each covering
+/// its share of the distance, so that position, lateral speed (peaking at `p`)
+/// and lateral acceleration (zero at `p`) are continuous; only the jerk steps at
+/// `p`. The peak acceleration is the quintic's times `1 / (2 min(p, 1 − p))`.
 fn asymmetric(tau: f64, peak: f64) -> f64 {
     let tau = tau.clamp(0.0, 1.0);
-    let (a, b) = asymmetric_exponents(peak);
-    (speed_integral(tau, a, b) / speed_integral(1.0, a, b)).clamp(0.0, 1.0)
+    if tau <= peak {
+        2.0 * peak * quintic(tau / (2.0 * peak))
+    } else {
+        1.0 - 2.0 * (1.0 - peak) * quintic((1.0 - tau) / (2.0 * (1.0 - peak)))
+    }
 }
 
 /// The monotone piecewise cubic Hermite interpolant of `points` at `t` (Fritsch
@@ -356,7 +320,7 @@ mod tests {
 
     #[test]
     fn the_asymmetric_speed_peaks_where_asked() {
-        for peak in [0.25, 0.4, 0.6, 0.8] {
+        for peak in [0.3, 0.4, 0.6, 0.7] {
             let shape = LateralProfile::Asymmetric {
                 peak_fraction: peak,
             };

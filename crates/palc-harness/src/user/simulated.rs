@@ -16,6 +16,10 @@ use crate::user::profile::TABLE_END_TOLERANCE_M;
 use crate::user::spread::Spread;
 use crate::user::style::Style;
 
+/// Most draws of one lane change's parameters (a draw whose lane change fails the
+/// sanity checks is drawn again).
+pub const MAX_DRAWS: usize = 100;
+
 /// A simulated user: a nominal [`Style`] refined by a [`Family`], the deviation
 /// threshold of its takeovers and, optionally, a [`Spread`] of its parameters.
 #[derive(Debug, Clone)]
@@ -267,14 +271,26 @@ impl User for SimulatedUser {
         self.expectation(&self.style, &self.family, setup)
     }
 
+    /// The next lane change; a user with spread draws its parameters anew, and
+    /// draws again (up to [`MAX_DRAWS`] times) while the drawn lane change fails
+    /// its sanity checks, so that one unlucky draw does not end a run.
     fn next(&mut self, setup: &Setup) -> Result<Expectation, HarnessError> {
-        match (&self.spread, self.rng.as_mut()) {
-            (Some(spread), Some(rng)) if spread.is_active() => {
-                let (style, family) = spread.draw(&self.style, &self.family, rng);
-                self.expectation(&style, &family, setup)
+        let Some(spread) = self.spread.filter(Spread::is_active) else {
+            return self.nominal(setup);
+        };
+        let mut last = None;
+        for _ in 0..MAX_DRAWS {
+            let Some(rng) = self.rng.as_mut() else { break };
+            let (style, family) = spread.draw(&self.style, &self.family, rng);
+            match self.expectation(&style, &family, setup) {
+                Ok(expectation) => return Ok(expectation),
+                Err(error) => last = Some(error),
             }
-            _ => self.nominal(setup),
         }
+        Err(last.unwrap_or_else(|| HarnessError::Scenario {
+            scenario: setup.label.clone(),
+            reason: format!("user `{}` has no generator for its spread", self.name),
+        }))
     }
 
     fn has_spread(&self) -> bool {

@@ -99,6 +99,34 @@ pub struct ParameterSpread {
     pub comfort_ttc_s: Option<Draw>,
 }
 
+impl ParameterSpread {
+    /// Checks every half-width, naming the field under `table`
+    /// (`{table}.reaction_s.absolute`).
+    pub fn validate(&self, table: &str) -> Result<(), HarnessError> {
+        let named = [
+            ("start_threshold", self.start_threshold),
+            ("duration_s", self.duration_s),
+            ("reaction_s", self.reaction_s),
+            ("min_lead_gap_s", self.min_lead_gap_s),
+            ("min_lag_gap_s", self.min_lag_gap_s),
+            ("peak_fraction", self.peak_fraction),
+            ("max_acceleration_mps2", self.max_acceleration_mps2),
+            ("comfort_time_gap_s", self.comfort_time_gap_s),
+            ("comfort_ttc_s", self.comfort_ttc_s),
+        ];
+        for (name, draw) in named {
+            if let Some(draw) = draw {
+                let kind = match draw {
+                    Draw::Relative(_) => "relative",
+                    Draw::Absolute(_) => "absolute",
+                };
+                draw.validate(&format!("{table}.{name}.{kind}"))?;
+            }
+        }
+        Ok(())
+    }
+}
+
 /// How much a user's parameters vary between lane changes.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -118,28 +146,7 @@ impl Spread {
     /// Checks every half-width, naming the field under `table`.
     pub fn validate(&self, table: &str) -> Result<(), HarnessError> {
         Draw::Relative(self.relative).validate(&format!("{table}.relative"))?;
-        let p = &self.parameters;
-        let named = [
-            ("start_threshold", p.start_threshold),
-            ("duration_s", p.duration_s),
-            ("reaction_s", p.reaction_s),
-            ("min_lead_gap_s", p.min_lead_gap_s),
-            ("min_lag_gap_s", p.min_lag_gap_s),
-            ("peak_fraction", p.peak_fraction),
-            ("max_acceleration_mps2", p.max_acceleration_mps2),
-            ("comfort_time_gap_s", p.comfort_time_gap_s),
-            ("comfort_ttc_s", p.comfort_ttc_s),
-        ];
-        for (name, draw) in named {
-            if let Some(draw) = draw {
-                let kind = match draw {
-                    Draw::Relative(_) => "relative",
-                    Draw::Absolute(_) => "absolute",
-                };
-                draw.validate(&format!("{table}.parameters.{name}.{kind}"))?;
-            }
-        }
-        Ok(())
+        self.parameters.validate(&format!("{table}.parameters"))
     }
 
     /// Whether any parameter is drawn with a positive half-width.
