@@ -148,8 +148,8 @@ impl ClarabelBackend {
         Ok(RawSolution {
             status,
             iterations: solution.iterations,
-            x: solution.x.clone(),
-            z: solution.z.clone(),
+            primal: solution.x.clone(),
+            multipliers: solution.z.clone(),
             reused,
             setup_seconds,
             solve_seconds,

@@ -3,6 +3,7 @@
 //! stages (4 x 4 state and 2 x 2 control blocks), instead of a general sparse LDLᵀ.
 //!
 //! - [`stage_qp`]: reads the assembled [`QpData`] back into stage form;
+//! - [`params`]: the named constants of the recursion and the interior point;
 //! - [`recursion`]: the Riccati factorization and solve, terminal rows by a Schur
 //!   complement on their multiplier;
 //! - [`sparse`]: products with `A_i`, `B_i` in the kinematic bicycle's pattern;
@@ -12,6 +13,7 @@
 //! Every buffer is sized once per plan; nothing is allocated inside the iterations.
 
 mod ipm;
+mod params;
 mod recursion;
 mod sparse;
 mod stage_qp;
@@ -32,12 +34,16 @@ pub(crate) struct RiccatiBackend {
 }
 
 impl RiccatiBackend {
+    /// Solves the assembled QP; with `warm`, from the last solution shifted by one step
+    /// (see [`Planner::replan`](crate::Planner::replan)) when the last solve solved a
+    /// problem of the same pattern, else from Mehrotra's start.
     pub fn solve(
         &mut self,
         data: &QpData,
         pattern: Pattern,
         horizon: usize,
         settings: &SolverSettings,
+        warm: bool,
     ) -> Result<RawSolution, PlanError> {
         let start = std::time::Instant::now();
         self.qp
@@ -48,6 +54,7 @@ impl RiccatiBackend {
             })?;
         let reused = self.pattern.as_ref() == Some(&pattern);
         self.pattern = Some(pattern);
+        let warm = warm && reused && self.ipm.prepare_warm_start(&self.qp);
         self.ipm.resize(&self.qp);
         let setup_seconds = start.elapsed().as_secs_f64();
 
@@ -60,6 +67,7 @@ impl RiccatiBackend {
                 gap_rel: settings.tol_gap_rel,
                 feas: settings.tol_feas,
             },
+            warm,
         );
         let solve_seconds = start.elapsed().as_secs_f64();
         let status = match outcome {
@@ -71,8 +79,8 @@ impl RiccatiBackend {
         Ok(RawSolution {
             status,
             iterations: self.ipm.iterations,
-            x: self.primal(data.n),
-            z: self.multipliers(),
+            primal: self.primal(data.n),
+            multipliers: self.multipliers(),
             reused,
             setup_seconds,
             solve_seconds,
@@ -81,28 +89,29 @@ impl RiccatiBackend {
 
     /// The primal iterate in the variable order of [`QpData`].
     fn primal(&self, n: usize) -> Vec<f64> {
-        let k = self.qp.k;
+        let (k, v) = (self.qp.k, &self.ipm.v);
         let mut x = Vec::with_capacity(n);
         for i in 0..k {
-            x.extend(self.ipm.z[i].iter());
+            x.extend(v.ux[i].iter());
         }
-        x.extend(self.ipm.z[k].iter().take(NX));
-        x.extend(&self.ipm.sigma);
+        x.extend(v.ux[k].iter().take(NX));
+        x.extend(&v.sigma);
         debug_assert_eq!(x.len(), n);
-        debug_assert_eq!(NZ * k + NX + self.ipm.sigma.len(), n);
+        debug_assert_eq!(NZ * k + NX + v.sigma.len(), n);
         x
     }
 
     /// The multipliers in the row order of [`QpData`]: `X_0`, dynamics, terminal,
     /// inequalities.
     fn multipliers(&self) -> Vec<f64> {
-        let mut z = Vec::with_capacity(self.qp.m_eq + self.ipm.lambda.len());
-        z.extend(self.ipm.y_initial.iter());
-        for y in &self.ipm.y_dynamics {
+        let v = &self.ipm.v;
+        let mut z = Vec::with_capacity(self.qp.m_eq + v.lambda.len());
+        z.extend(v.y_initial.iter());
+        for y in &v.y_dynamics {
             z.extend(y.iter());
         }
-        z.extend(self.ipm.y_terminal.iter().take(self.qp.terminal_rows));
-        z.extend(&self.ipm.lambda);
+        z.extend(v.y_terminal.iter().take(self.qp.terminal_rows));
+        z.extend(&v.lambda);
         z
     }
 }

@@ -41,6 +41,15 @@ pub(crate) struct Inequality {
     pub h: f64,
 }
 
+impl Inequality {
+    /// `(G x)_j` of this row for the stage variables `ux` and the slacks `σ`.
+    #[inline(always)]
+    pub fn times(&self, ux: &[Vector6<f64>], sigma: &[f64]) -> f64 {
+        self.core.map_or(0.0, |(i, l)| self.coef * ux[i][l])
+            + self.slack.map_or(0.0, |k| self.slack_coef * sigma[k])
+    }
+}
+
 /// The QP of [`QpData`] in stage form.
 #[derive(Debug, Default)]
 pub(crate) struct StageQp {
@@ -67,9 +76,9 @@ pub(crate) struct StageQp {
     pub slack_cost: Vec<f64>,
     /// The stage variable each slack is tied to by its rows, if any.
     pub slack_core: Vec<Option<(usize, usize)>>,
-    /// The inequality rows of each slack (at most [`MAX_SLACK_ROWS`]; unused entries
-    /// `usize::MAX`).
-    pub slack_rows: Vec<[usize; MAX_SLACK_ROWS]>,
+    /// The inequality rows of each slack (at most [`MAX_SLACK_ROWS`], first; the unused
+    /// entries `None`).
+    pub slack_rows: Vec<[Option<usize>; MAX_SLACK_ROWS]>,
     /// Inequality rows in the order of the QP's rows.
     pub inequalities: Vec<Inequality>,
     /// Equality rows `m_eq = 4 + 4K + m`.
@@ -224,14 +233,13 @@ impl StageQp {
             }
         }
         self.slack_rows.clear();
-        self.slack_rows
-            .resize(n_slack, [usize::MAX; MAX_SLACK_ROWS]);
+        self.slack_rows.resize(n_slack, [None; MAX_SLACK_ROWS]);
         for (row, ineq) in self.inequalities.iter().enumerate() {
             let Some(j) = ineq.slack else { continue };
-            let Some(free) = self.slack_rows[j].iter_mut().find(|r| **r == usize::MAX) else {
+            let Some(free) = self.slack_rows[j].iter_mut().find(|r| r.is_none()) else {
                 return Err(LayoutError::Slack { slack: j });
             };
-            *free = row;
+            *free = Some(row);
             if let Some(core) = ineq.core {
                 match self.slack_core[j] {
                     None => self.slack_core[j] = Some(core),
@@ -242,7 +250,7 @@ impl StageQp {
                 }
             }
         }
-        if let Some(j) = self.slack_rows.iter().position(|r| r[0] == usize::MAX) {
+        if let Some(j) = self.slack_rows.iter().position(|r| r[0].is_none()) {
             return Err(LayoutError::Slack { slack: j });
         }
         self.softly_bounded.clear();
