@@ -19,7 +19,8 @@ pub(crate) enum RawStatus {
     Failed(SolverFailure),
 }
 
-/// Raw result of one solve, in the variable and row order of [`QpData`](crate::qp::QpData).
+/// Raw result of one solve, in the flat variable and row order of
+/// [`StageQp`](crate::qp::StageQp).
 #[derive(Debug, Clone)]
 pub(crate) struct RawSolution {
     pub status: RawStatus,

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use crate::backend::RawStatus;
 #[cfg(feature = "clarabel")]
 use crate::clarabel_backend::ClarabelBackend;
-use crate::qp::{QpData, RowTag, control_index, pattern_of, state_index};
+use crate::qp::{RowTag, StageQp, control_index, pattern_of, state_index};
 use crate::riccati::RiccatiBackend;
 use crate::validate::validate_problem;
 use crate::{
@@ -92,7 +92,7 @@ pub struct Plan {
 #[derive(Debug)]
 pub struct Planner {
     config: PlannerConfig,
-    data: QpData,
+    qp: StageQp,
     #[cfg(feature = "clarabel")]
     clarabel: ClarabelBackend,
     riccati: RiccatiBackend,
@@ -128,7 +128,7 @@ impl Planner {
         config.validate()?;
         Ok(Self {
             config,
-            data: QpData::default(),
+            qp: StageQp::default(),
             #[cfg(feature = "clarabel")]
             clarabel: ClarabelBackend::default(),
             riccati: RiccatiBackend::default(),
@@ -174,21 +174,17 @@ impl Planner {
     fn solve_inner(&mut self, problem: &Problem, warm: bool) -> Result<Plan, PlanError> {
         let start = std::time::Instant::now();
         validate_problem(&self.config, problem)?;
-        self.data.assemble(&self.config, problem);
+        self.qp.assemble(&self.config, problem);
         let assembled = start.elapsed().as_secs_f64();
         let pattern = pattern_of(problem);
         let raw = match self.config.backend {
-            Backend::Riccati => self.riccati.solve(
-                &self.data,
-                pattern,
-                self.config.horizon,
-                &self.config.solver,
-                warm,
-            )?,
+            Backend::Riccati => self
+                .riccati
+                .solve(&self.qp, pattern, &self.config.solver, warm),
             #[cfg(feature = "clarabel")]
             Backend::Clarabel => self
                 .clarabel
-                .solve(&self.data, pattern, &self.config.solver)?,
+                .solve(&self.qp, pattern, &self.config.solver)?,
             // `Planner::new` validated the configuration, which refuses this backend.
             #[cfg(not(feature = "clarabel"))]
             Backend::Clarabel => {
@@ -216,7 +212,7 @@ impl Planner {
         let states: Vec<State> = (0..=k)
             .map(|i| {
                 let o = state_index(i);
-                State::from_array([x[o] + self.data.origin, x[o + 1], x[o + 2], x[o + 3]])
+                State::from_array([x[o] + self.qp.origin, x[o + 1], x[o + 2], x[o + 3]])
             })
             .collect();
         let controls: Vec<Control> = (0..k)
@@ -229,10 +225,10 @@ impl Planner {
             })
             .collect();
         let lateral_violation: Vec<f64> = self
-            .data
+            .qp
             .slack_of_step
             .iter()
-            .map(|s| s.map_or(0.0, |j| x[j]))
+            .map(|s| s.map_or(0.0, |j| x[self.qp.slack_column(j)]))
             .collect();
         let features = features(&states, &controls, &problem.preceding, &problem.adjacent)?;
         #[allow(
@@ -245,7 +241,7 @@ impl Planner {
             .expect("weights and features share the horizon");
         let extras = self.extras(problem, &states, &controls, &lateral_violation);
         Ok(Plan {
-            objective: self.data.objective(x),
+            objective: self.qp.objective(x),
             states,
             controls,
             learned_cost,
@@ -296,12 +292,12 @@ impl Planner {
 
     /// Reads the steps that carry clarabel's primal infeasibility certificate.
     fn infeasible(&self, z: &[f64]) -> PlanError {
-        let m_eq = self.data.m_eq;
+        let m_eq = self.qp.m_eq;
         let scale = z.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let threshold = 1e-6 * scale;
         let mut lateral = Vec::new();
         let mut steering = Vec::new();
-        for (tag, &zi) in self.data.row_tags.iter().zip(&z[m_eq..]) {
+        for (tag, &zi) in self.qp.row_tags.iter().zip(&z[m_eq..]) {
             if zi.abs() <= threshold {
                 continue;
             }

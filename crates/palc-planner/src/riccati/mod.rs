@@ -2,7 +2,7 @@
 //! whose Newton systems are solved by a time-varying Riccati recursion over the
 //! stages (4 x 4 state and 2 x 2 control blocks), instead of a general sparse LDLᵀ.
 //!
-//! - [`stage_qp`]: reads the assembled [`QpData`] back into stage form;
+//! - the QP it solves is the stage form of [`StageQp`], read as it is assembled;
 //! - [`params`]: the named constants of the recursion and the interior point;
 //! - [`recursion`]: the Riccati factorization and solve, terminal rows by a Schur
 //!   complement on their multiplier;
@@ -16,19 +16,16 @@ mod ipm;
 mod params;
 mod recursion;
 mod sparse;
-mod stage_qp;
 
 use crate::backend::{RawSolution, RawStatus};
-use crate::qp::{Pattern, QpData};
-use crate::{NumericalCause, PlanError, SolverSettings};
+use crate::qp::{NX, NZ, Pattern, StageQp};
 
 use ipm::{Ipm, Outcome, Tolerances};
-use stage_qp::{NX, NZ, StageQp};
+pub(crate) use sparse::StepDynamics;
 
 /// The Riccati interior-point backend with its buffers, kept between plans.
 #[derive(Debug, Default)]
 pub(crate) struct RiccatiBackend {
-    qp: StageQp,
     ipm: Ipm,
     pattern: Option<Pattern>,
 }
@@ -39,28 +36,21 @@ impl RiccatiBackend {
     /// problem of the same pattern, else from Mehrotra's start.
     pub fn solve(
         &mut self,
-        data: &QpData,
+        qp: &StageQp,
         pattern: Pattern,
-        horizon: usize,
-        settings: &SolverSettings,
+        settings: &crate::SolverSettings,
         warm: bool,
-    ) -> Result<RawSolution, PlanError> {
+    ) -> RawSolution {
         let start = std::time::Instant::now();
-        self.qp
-            .load(data, horizon)
-            .map_err(|layout| PlanError::SolverFailed {
-                status: NumericalCause::StageLayout(layout).into(),
-                iterations: 0,
-            })?;
         let reused = self.pattern.as_ref() == Some(&pattern);
         self.pattern = Some(pattern);
-        let warm = warm && reused && self.ipm.prepare_warm_start(&self.qp);
-        self.ipm.resize(&self.qp);
+        let warm = warm && reused && self.ipm.prepare_warm_start(qp);
+        self.ipm.resize(qp);
         let setup_seconds = start.elapsed().as_secs_f64();
 
         let start = std::time::Instant::now();
         let outcome = self.ipm.run(
-            &self.qp,
+            qp,
             &Tolerances {
                 max_iter: settings.max_iter,
                 gap_abs: settings.tol_gap_abs,
@@ -76,41 +66,41 @@ impl RiccatiBackend {
             Outcome::PrimalInfeasible => RawStatus::PrimalInfeasible,
             Outcome::Failed(reason) => RawStatus::Failed(reason),
         };
-        Ok(RawSolution {
+        RawSolution {
             status,
             iterations: self.ipm.iterations,
-            primal: self.primal(data.n),
-            multipliers: self.multipliers(),
+            primal: self.primal(qp),
+            multipliers: self.multipliers(qp),
             reused,
             setup_seconds,
             solve_seconds,
-        })
+        }
     }
 
-    /// The primal iterate in the variable order of [`QpData`].
-    fn primal(&self, n: usize) -> Vec<f64> {
-        let (k, v) = (self.qp.k, &self.ipm.v);
-        let mut x = Vec::with_capacity(n);
+    /// The primal iterate as the flat vector `[X_0, U_0, ..., X_K, σ]` of [`StageQp`].
+    fn primal(&self, qp: &StageQp) -> Vec<f64> {
+        let (k, v) = (qp.k, &self.ipm.v);
+        let mut x = Vec::with_capacity(qp.n());
         for i in 0..k {
             x.extend(v.ux[i].iter());
         }
         x.extend(v.ux[k].iter().take(NX));
         x.extend(&v.sigma);
-        debug_assert_eq!(x.len(), n);
-        debug_assert_eq!(NZ * k + NX + v.sigma.len(), n);
+        debug_assert_eq!(x.len(), qp.n());
+        debug_assert_eq!(NZ * k + NX + v.sigma.len(), qp.n());
         x
     }
 
-    /// The multipliers in the row order of [`QpData`]: `X_0`, dynamics, terminal,
+    /// The multipliers in the row order of [`StageQp`]: `X_0`, dynamics, terminal,
     /// inequalities.
-    fn multipliers(&self) -> Vec<f64> {
+    fn multipliers(&self, qp: &StageQp) -> Vec<f64> {
         let v = &self.ipm.v;
-        let mut z = Vec::with_capacity(self.qp.m_eq + v.lambda.len());
+        let mut z = Vec::with_capacity(qp.m_eq + v.lambda.len());
         z.extend(v.y_initial.iter());
         for y in &v.y_dynamics {
             z.extend(y.iter());
         }
-        z.extend(v.y_terminal.iter().take(self.qp.terminal_rows));
+        z.extend(v.y_terminal.iter().take(qp.terminal_rows));
         z.extend(&v.lambda);
         z
     }

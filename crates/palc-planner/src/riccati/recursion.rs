@@ -30,7 +30,7 @@ use super::params::{
     CONTROL_REGULARIZATION, CONTROL_REGULARIZATION_RELATIVE, TERMINAL_FLOOR, TERMINAL_REFINEMENTS,
     TERMINAL_REGULARIZATION, TERMINAL_TOLERANCE,
 };
-use super::stage_qp::{Dynamics, NX};
+use crate::qp::{Dynamics, NX};
 
 /// Why a factorization failed.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -19,11 +19,11 @@
 use nalgebra::{Vector4, Vector6};
 
 use super::super::recursion::{FactorError, Rhs, Riccati, Step};
-use super::super::stage_qp::StageQp;
 use super::head;
 use super::residuals::Residuals;
 use super::step::dual_step;
 use super::variables::{Direction, Variables, resize_fill};
+use crate::qp::StageQp;
 
 /// The Newton system's data, its factorization and its solve buffers.
 #[derive(Debug, Default)]

@@ -43,7 +43,7 @@ use super::params::{
     REFINE_SHORTFALL, START_BALANCE, START_COMPLEMENTARITY, START_SHIFT, START_UNIT_SHIFT,
 };
 use super::recursion::FactorError;
-use super::stage_qp::StageQp;
+use crate::qp::StageQp;
 use crate::{NumericalCause, SolverFailure};
 use info::{Measures, Progress};
 pub(crate) use info::{Outcome, Tolerances};

@@ -16,10 +16,10 @@
 
 use nalgebra::{Vector4, Vector6};
 
-use super::super::stage_qp::{NX, StageQp};
 use super::head;
 use super::info::Measures;
 use super::variables::{Variables, resize_fill};
+use crate::qp::{NX, StageQp};
 
 /// The residuals of the current iterate, in stage form.
 #[derive(Debug, Default)]

@@ -10,8 +10,8 @@
 
 use super::super::params::{CENTERING_EXPONENT, MAX_STEP_FRACTION, MU_GROWTH, STEP_FRACTION};
 use super::super::recursion::FactorError;
-use super::super::stage_qp::StageQp;
 use super::Ipm;
+use crate::qp::StageQp;
 
 /// `Δλ_j = -(r_c + λ Δs) / s` of one row, and the step bound `α` tightened so that
 /// `s + α Δs >= 0` and `λ + α Δλ >= 0` (a division only where the bound tightens,

@@ -1,6 +1,6 @@
 //! The primal-dual iterate of the interior point and the Newton direction.
 //!
-//! The QP of [`StageQp`](super::super::stage_qp::StageQp) in the interior point's
+//! The QP of [`StageQp`](crate::qp::StageQp) in the interior point's
 //! notation (clarabel's, with the stage structure kept):
 //!
 //! ```text

@@ -18,8 +18,8 @@
 use nalgebra::Vector6;
 
 use super::super::params::WARM_GAP;
-use super::super::stage_qp::{Inequality, NX, StageQp};
 use super::Ipm;
+use crate::qp::{Inequality, NX, StageQp};
 
 /// Kinds of inequality rows told apart when shifting: `(local index, sign, kind)`,
 /// kind 0 a row on a stage variable only, 1 a row with its soft-bound slack, 2 a row on
