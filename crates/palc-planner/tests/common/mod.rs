@@ -8,6 +8,8 @@ use proptest::prelude::*;
 
 #[path = "../../fixtures/lane_change.rs"]
 mod lane_change_fixture;
+// Not every test binary re-plans.
+#[allow(unused_imports)]
 pub use lane_change_fixture::{lane_change, shifted};
 
 /// Random weights in the convex set: every stage block is PSD by construction

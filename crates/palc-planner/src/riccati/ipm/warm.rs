@@ -123,12 +123,13 @@ impl Ipm {
             w.s[j] = s;
             w.lambda[j] = l;
         }
-        let finite = w.ux.iter().all(|x| x.iter().all(|v| v.is_finite()))
+        // A non-finite previous solution (it would have failed its own stopping rule)
+        // is never a start.
+        w.ux.iter().all(|x| x.iter().all(|v| v.is_finite()))
             && w.s
                 .iter()
                 .chain(&w.lambda)
                 .chain(&w.sigma)
-                .all(|v| v.is_finite());
-        finite
+                .all(|v| v.is_finite())
     }
 }
