@@ -318,11 +318,6 @@ impl StageQp {
         NZ * self.k + NX + self.slack_cost.len()
     }
 
-    /// Number of inequality rows.
-    pub fn m_in(&self) -> usize {
-        self.inequalities.len()
-    }
-
     /// Column of slack `j` in the flat variable vector.
     pub fn slack_column(&self, j: usize) -> usize {
         NZ * self.k + NX + j

@@ -49,7 +49,7 @@ impl SparseQp {
         let k = qp.k;
         self.n = qp.n();
         self.m_eq = qp.m_eq;
-        self.m_in = qp.m_in();
+        self.m_in = qp.inequalities.len();
         for v in [
             &mut self.p_rows,
             &mut self.p_cols,
