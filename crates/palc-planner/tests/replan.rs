@@ -7,7 +7,10 @@ use common::{convex_problem, lane_change, shifted};
 use palc_planner::{LateralBound, LateralBoundsMode, Plan, Planner, PlannerConfig, Problem};
 use proptest::prelude::*;
 
-/// Whether two plans are the same optimum to the solver's tolerances.
+/// Whether two plans are the same optimum to the solver's tolerances: objectives to
+/// 1e-6 relative and trajectories to 1e-3 (m, m/s, rad), as in `backends_agree.rs`:
+/// both stop at a relative gap of 1e-8, and in the flattest random problems that
+/// leaves the lateral position free to about 1e-4.
 fn same_optimum(a: &Plan, b: &Plan) -> Result<(), TestCaseError> {
     let scale = 1.0 + b.objective.abs();
     prop_assert!(
@@ -17,8 +20,12 @@ fn same_optimum(a: &Plan, b: &Plan) -> Result<(), TestCaseError> {
         b.objective
     );
     for (x, y) in a.states.iter().zip(&b.states) {
-        prop_assert!((x.l - y.l).abs() < 1e-4 && (x.s - y.s).abs() < 1e-3);
-        prop_assert!((x.v - y.v).abs() < 1e-4 && (x.phi - y.phi).abs() < 1e-4);
+        let close = x
+            .to_array()
+            .iter()
+            .zip(y.to_array())
+            .all(|(p, q)| (p - q).abs() <= 1e-3);
+        prop_assert!(close, "states {x:?} and {y:?}");
     }
     Ok(())
 }

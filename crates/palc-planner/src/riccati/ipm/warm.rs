@@ -123,6 +123,44 @@ impl Ipm {
             w.s[j] = s;
             w.lambda[j] = l;
         }
+        // The last stage: the old stage K becomes stage K - 1 and gains the stage cost
+        // the old one did not have. Its state rows of the stationarity condition fix the
+        // multiplier of the last dynamics rows, `A_{K-1}ᵀ y_{K-1} = y_{K-2} + ∇_x ℓ_{K-1}
+        // + (Gᵀλ)_{K-1}`, and stage K's then fix the terminal multiplier
+        // `Eᵀν = -(y_{K-1} + ∇_x ℓ_K + (Gᵀλ)_K)`: the dual residual is left on the
+        // controls of stage K - 1 and on the rows of X_K that no terminal row fixes.
+        let mut gl = [Vector6::zeros(); 2];
+        for (row, &l) in qp.inequalities.iter().zip(&w.lambda) {
+            if let Some((i, c)) = row.core {
+                if i + 1 >= k {
+                    gl[i + 1 - k][c] += row.coef * l;
+                }
+            }
+        }
+        let state_rows = |i: usize, g: &Vector6<f64>| {
+            (qp.hessian[i] * w.ux[i] + qp.linear[i] + g)
+                .fixed_rows::<NX>(0)
+                .into_owned()
+        };
+        let incoming = if k >= 2 {
+            w.y_dynamics[k - 2]
+        } else {
+            w.y_initial
+        };
+        let (a, _) = qp.dynamics[k - 1].sparse.dense();
+        if let Some(y) = a
+            .transpose()
+            .try_inverse()
+            .map(|inv| inv * (incoming + state_rows(k - 1, &gl[0])))
+        {
+            w.y_dynamics[k - 1] = y;
+            let rest = -(y + state_rows(k, &gl[1]));
+            for j in 0..qp.terminal_rows {
+                if let Some(c) = (0..NX).find(|&c| qp.terminal[(j, c)] != 0.0) {
+                    w.y_terminal[j] = rest[c] / qp.terminal[(j, c)];
+                }
+            }
+        }
         // A non-finite previous solution (it would have failed its own stopping rule)
         // is never a start.
         w.ux.iter().all(|x| x.iter().all(|v| v.is_finite()))
