@@ -9,7 +9,12 @@
 //! multiplier of the new initial rows, Eq. 20: both are the incoming multiplier of the
 //! same state), and the `σ` and `λ` of the same bound one step later. The last stage
 //! repeats the old last control and propagates the dynamics, so that every equality
-//! row but the changed initial state holds. The inequality slacks are then
+//! row but the changed initial state holds. The new stage `K - 1` (the old stage `K`)
+//! has a stage cost the old one had not; the multipliers of the last dynamics rows and
+//! of the terminal rows are set from the stationarity of the last two stages' states,
+//! which leaves the dual residual on the last controls only (without it, the shifted
+//! multipliers left a dual residual of 4e-2 there and the re-plan took one more
+//! iteration). The inequality slacks are then
 //! `s = h - G x` (zero inequality residual), and each pair `(s_j, λ_j)` is moved off
 //! the boundary to `s_j λ_j >= μ` with `m μ` a small fraction of the objective
 //! ([`WARM_GAP`]): the interior point needs a central iterate, and an exact
