@@ -19,7 +19,7 @@
 //!
 //! The cold start is Mehrotra's: the Newton system with `W = I` at `x = 0`, then `s`
 //! and `λ` shifted into the positive orthant. The warm start of a re-plan
-//! ([`Ipm::warm_start`]) shifts the previous solution by one step and moves it off the
+//! ([`Ipm::prepare_warm_start`]) shifts the previous solution by one step and moves it off the
 //! boundary. The stopping rule uses clarabel's measures on the unscaled data (relative
 //! primal and dual residuals, absolute or relative gap), with the gap taken relative to
 //! the objective *with* its constant: the tracking term expands into `xᵀPx + qᵀx` parts
