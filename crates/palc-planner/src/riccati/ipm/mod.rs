@@ -76,7 +76,7 @@ pub(crate) struct Ipm {
     /// `AlmostSolved`): `v` then holds a solution a re-plan can start from.
     solved_objective: Option<f64>,
     /// The objective of the iterate the current run returns, if it solved.
-    best_objective: Option<f64>,
+    returned_objective: Option<f64>,
     /// Iterations of the last run.
     pub iterations: u32,
 }
@@ -99,7 +99,7 @@ impl Ipm {
     /// of [`prepare_warm_start`](Self::prepare_warm_start); `v` holds the result.
     pub fn run(&mut self, qp: &StageQp, tol: &Tolerances, warm: bool) -> Outcome {
         let outcome = self.iterations(qp, tol, warm);
-        self.solved_objective = match (&outcome, self.best_objective) {
+        self.solved_objective = match (&outcome, self.returned_objective) {
             (Outcome::Solved | Outcome::AlmostSolved, Some(objective)) => Some(objective),
             _ => None,
         };
@@ -108,7 +108,7 @@ impl Ipm {
 
     /// The iterations of [`run`](Self::run).
     fn iterations(&mut self, qp: &StageQp, tol: &Tolerances, warm: bool) -> Outcome {
-        self.best_objective = None;
+        self.returned_objective = None;
         if warm {
             self.v.copy_from(&self.shifted);
         } else if let Err(e) = self.start(qp) {
@@ -118,7 +118,7 @@ impl Ipm {
         loop {
             let measures = self.residuals.compute(qp, &self.v);
             if measures.meets(tol.gap_abs, tol.gap_rel, tol.feas) {
-                self.best_objective = Some(measures.objective);
+                self.returned_objective = Some(measures.objective);
                 return Outcome::Solved;
             }
             if measures.infeasible(INFEASIBILITY_TOLERANCE) {
@@ -156,7 +156,7 @@ impl Ipm {
     /// tolerance, or the failure `reason`.
     fn stop(&mut self, progress: &Progress, current: &Measures, reason: SolverFailure) -> Outcome {
         if let Some((best, _)) = progress.best {
-            self.best_objective = Some(best.objective);
+            self.returned_objective = Some(best.objective);
             self.v.copy_from(&self.best);
             return Outcome::AlmostSolved;
         }
