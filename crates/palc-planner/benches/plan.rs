@@ -8,16 +8,23 @@
 //!
 //! Percentiles (p50, p99) and the speed-up in one run:
 //! `cargo run --release -p palc-planner --example plan_latency`.
+//!
+//! `closed_loop` (K = 120, dt = 0.05, the Riccati backend): a plan with hard and with
+//! soft lateral bounds (`hard`, `soft`), and the closed loop's re-plan (`warm_hard`,
+//! `warm_soft`): a chain of 40 problems, each one step after the last
+//! (`lane_change_fixture::shifted`), re-planned with `Planner::replan` from the plan of
+//! the one before; the chain restarts with a cold plan every 40 plans. Criterion's
+//! median is the p50.
 
 use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use palc_planner::{Backend, LateralBoundsMode, Planner, PlannerConfig, Problem};
+use palc_planner::{Backend, LateralBoundsMode, Plan, Planner, PlannerConfig, Problem};
 
 #[path = "../fixtures/lane_change.rs"]
 mod lane_change_fixture;
-use lane_change_fixture::lane_change as problem;
+use lane_change_fixture::{lane_change as problem, shifted};
 
 fn bench_plan(c: &mut Criterion) {
     let mut group = c.benchmark_group("plan");
@@ -70,5 +77,59 @@ fn bench_plan(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, bench_plan);
+/// Plans in closed loop at K = 120, dt = 0.05: cold plans and warm re-plans.
+fn bench_closed_loop(c: &mut Criterion) {
+    const CHAIN: usize = 40;
+    let mut group = c.benchmark_group("closed_loop");
+    group
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(3));
+    for (mode_name, mode) in [
+        ("hard", LateralBoundsMode::Hard),
+        ("soft", LateralBoundsMode::Soft { weight: 100.0 }),
+    ] {
+        let config = PlannerConfig {
+            horizon: 120,
+            dt: 0.05,
+            backend: Backend::Riccati,
+            lateral_bounds_mode: mode,
+            ..PlannerConfig::default()
+        };
+        let mut planner = Planner::new(config.clone()).unwrap();
+        let problems: Vec<Problem> = [18.0, 20.0, 22.0, 26.0]
+            .iter()
+            .map(|&v| problem(&config, v))
+            .collect();
+        let mut n = 0;
+        group.bench_function(mode_name, |b| {
+            b.iter(|| {
+                n += 1;
+                black_box(planner.plan(&problems[n % problems.len()]).unwrap())
+            })
+        });
+        // The chain of the closed loop, planned once.
+        let mut chain = vec![problem(&config, 20.0)];
+        let mut previous = planner.plan(&chain[0]).unwrap();
+        for _ in 1..CHAIN {
+            let next = shifted(chain.last().unwrap(), &previous);
+            previous = planner.replan(&next, &previous).unwrap();
+            chain.push(next);
+        }
+        let mut previous: Option<Plan> = None;
+        let mut n = 0;
+        group.bench_function(format!("warm_{mode_name}"), |b| {
+            b.iter(|| {
+                n = (n + 1) % CHAIN;
+                let plan = match previous.as_ref().filter(|_| n != 0) {
+                    Some(previous) => planner.replan(&chain[n], previous).unwrap(),
+                    None => planner.plan(&chain[n]).unwrap(),
+                };
+                previous = Some(black_box(plan));
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench_closed_loop, bench_plan);
 criterion_main!(benches);

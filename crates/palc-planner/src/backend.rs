@@ -9,7 +9,7 @@ pub(crate) enum RawStatus {
     Solved,
     /// Solved to reduced tolerances only.
     AlmostSolved,
-    /// A certificate of primal infeasibility was found (in `RawSolution::z`).
+    /// A certificate of primal infeasibility was found (in `RawSolution::multipliers`).
     PrimalInfeasible,
     /// A certificate of dual infeasibility (an unbounded direction) was found; only
     /// clarabel looks for one.
@@ -19,16 +19,17 @@ pub(crate) enum RawStatus {
     Failed(SolverFailure),
 }
 
-/// Raw result of one solve, in the variable and row order of [`QpData`](crate::qp::QpData).
+/// Raw result of one solve, in the flat variable and row order of
+/// [`StageQp`](crate::qp::StageQp).
 #[derive(Debug, Clone)]
 pub(crate) struct RawSolution {
     pub status: RawStatus,
     pub iterations: u32,
-    /// Primal variables `z` of the QP.
-    pub x: Vec<f64>,
-    /// Multipliers of all rows, equality rows first (length `m_eq + m_in`); on primal
-    /// infeasibility, the certificate.
-    pub z: Vec<f64>,
+    /// The primal variables `x` of the QP.
+    pub primal: Vec<f64>,
+    /// The multipliers `z` of all rows (clarabel's name), equality rows first (length
+    /// `m_eq + m_in`); on primal infeasibility, the certificate.
+    pub multipliers: Vec<f64>,
     pub reused: bool,
     pub setup_seconds: f64,
     pub solve_seconds: f64,

@@ -5,7 +5,8 @@ use clarabel::algebra::CscMatrix;
 use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, SupportedConeT};
 
 use crate::backend::{RawSolution, RawStatus};
-use crate::qp::{CscPattern, Pattern, QpData};
+use crate::qp::{Pattern, StageQp};
+use crate::sparse_qp::{CscPattern, SparseQp};
 use crate::{NumericalCause, PlanError, SolverFailure, SolverSettings};
 
 struct Cached {
@@ -19,6 +20,8 @@ struct Cached {
 #[derive(Default)]
 pub(crate) struct ClarabelBackend {
     cached: Option<Cached>,
+    /// The QP's sparse form, derived from the stage form for each plan.
+    data: SparseQp,
     p_nz: Vec<f64>,
     a_nz: Vec<f64>,
 }
@@ -53,11 +56,13 @@ fn settings(s: &SolverSettings) -> DefaultSettings<f64> {
 impl ClarabelBackend {
     pub fn solve(
         &mut self,
-        data: &QpData,
+        qp: &StageQp,
         pattern: Pattern,
         solver_settings: &SolverSettings,
     ) -> Result<RawSolution, PlanError> {
         let start = std::time::Instant::now();
+        self.data.fill(qp);
+        let data = &self.data;
         let reusable = solver_settings.reuse_structure
             && self
                 .cached
@@ -148,8 +153,8 @@ impl ClarabelBackend {
         Ok(RawSolution {
             status,
             iterations: solution.iterations,
-            x: solution.x.clone(),
-            z: solution.z.clone(),
+            primal: solution.x.clone(),
+            multipliers: solution.z.clone(),
             reused,
             setup_seconds,
             solve_seconds,

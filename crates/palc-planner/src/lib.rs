@@ -60,6 +60,8 @@ mod planner;
 mod problem;
 mod qp;
 mod riccati;
+#[cfg(feature = "clarabel")]
+mod sparse_qp;
 mod validate;
 mod weights;
 
@@ -69,7 +71,7 @@ pub use config::{
     TOLERANCE_RANGE,
 };
 pub use convexity::check_convexity;
-pub use error::{ConfigError, LayoutError, NumericalCause, PlanError, SolverFailure, StepRanges};
+pub use error::{ConfigError, NumericalCause, PlanError, SolverFailure, StepRanges};
 pub use features::{features, stage_features};
 pub use planner::{Extras, Plan, Planner, SolveStats, SolveStatus};
 pub use problem::{

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 use crate::backend::RawStatus;
 #[cfg(feature = "clarabel")]
 use crate::clarabel_backend::ClarabelBackend;
-use crate::qp::{QpData, RowTag, control_index, pattern_of, state_index};
+use crate::qp::{RowTag, StageQp, control_index, pattern_of, state_index};
 use crate::riccati::RiccatiBackend;
 use crate::validate::validate_problem;
 use crate::{
@@ -87,14 +87,39 @@ pub struct Plan {
 }
 
 /// The lane-change planner (Eqs. 9-23). Reuses its QP structure between plans with the
-/// same sparsity pattern.
+/// same sparsity pattern, and in closed loop starts from its last plan
+/// ([`replan`](Self::replan)).
 #[derive(Debug)]
 pub struct Planner {
     config: PlannerConfig,
-    data: QpData,
+    qp: StageQp,
     #[cfg(feature = "clarabel")]
     clarabel: ClarabelBackend,
     riccati: RiccatiBackend,
+    /// What identifies the last plan this planner returned (none after an error).
+    last: Option<PlanKey>,
+}
+
+/// What identifies a plan among the planner's own: the bits of its objective, its
+/// second and last states and its first control. `replan` warm-starts only from the
+/// planner's last plan, whose multipliers the backend still holds.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct PlanKey {
+    objective: u64,
+    second: Option<State>,
+    last: Option<State>,
+    first_control: Option<Control>,
+}
+
+impl PlanKey {
+    fn of(plan: &Plan) -> Self {
+        Self {
+            objective: plan.objective.to_bits(),
+            second: plan.states.get(1).copied(),
+            last: plan.states.last().copied(),
+            first_control: plan.controls.first().copied(),
+        }
+    }
 }
 
 impl Planner {
@@ -103,10 +128,11 @@ impl Planner {
         config.validate()?;
         Ok(Self {
             config,
-            data: QpData::default(),
+            qp: StageQp::default(),
             #[cfg(feature = "clarabel")]
             clarabel: ClarabelBackend::default(),
             riccati: RiccatiBackend::default(),
+            last: None,
         })
     }
 
@@ -118,22 +144,47 @@ impl Planner {
     /// Plans one lane change: minimizes `w · Φ(ψ) + extras` subject to the dynamics,
     /// the boundary conditions and the bounds.
     pub fn plan(&mut self, problem: &Problem) -> Result<Plan, PlanError> {
+        self.solve(problem, false)
+    }
+
+    /// Re-plans in closed loop: plans `problem`, the problem of `previous` one step
+    /// later (the same horizon, weights and bound pattern; `initial` the state
+    /// `previous` reaches after one step, positions relative to it as for any plan), as
+    /// [`plan`](Self::plan) does, but with the Riccati backend starts the interior point
+    /// from `previous` shifted by one step (its trajectory and its multipliers, moved
+    /// off the bounds) instead of Mehrotra's cold start: fewer iterations for the same
+    /// optimum, to the solver's tolerances.
+    ///
+    /// The warm start is used only when `previous` is the last plan this planner
+    /// returned (the backend still holds its multipliers) and the bound pattern is
+    /// unchanged; otherwise, and with [`Backend::Clarabel`], this is `plan(problem)`.
+    pub fn replan(&mut self, problem: &Problem, previous: &Plan) -> Result<Plan, PlanError> {
+        let warm = self.last == Some(PlanKey::of(previous));
+        self.solve(problem, warm)
+    }
+
+    /// Validates, assembles and solves; `warm`: start from the last plan shifted.
+    fn solve(&mut self, problem: &Problem, warm: bool) -> Result<Plan, PlanError> {
+        self.last = None;
+        let plan = self.solve_inner(problem, warm)?;
+        self.last = Some(PlanKey::of(&plan));
+        Ok(plan)
+    }
+
+    fn solve_inner(&mut self, problem: &Problem, warm: bool) -> Result<Plan, PlanError> {
         let start = std::time::Instant::now();
         validate_problem(&self.config, problem)?;
-        self.data.assemble(&self.config, problem);
+        self.qp.assemble(&self.config, problem);
         let assembled = start.elapsed().as_secs_f64();
         let pattern = pattern_of(problem);
         let raw = match self.config.backend {
-            Backend::Riccati => self.riccati.solve(
-                &self.data,
-                pattern,
-                self.config.horizon,
-                &self.config.solver,
-            )?,
+            Backend::Riccati => self
+                .riccati
+                .solve(&self.qp, pattern, &self.config.solver, warm),
             #[cfg(feature = "clarabel")]
             Backend::Clarabel => self
                 .clarabel
-                .solve(&self.data, pattern, &self.config.solver)?,
+                .solve(&self.qp, pattern, &self.config.solver)?,
             // `Planner::new` validated the configuration, which refuses this backend.
             #[cfg(not(feature = "clarabel"))]
             Backend::Clarabel => {
@@ -147,7 +198,7 @@ impl Planner {
         let status = match raw.status {
             RawStatus::Solved => SolveStatus::Solved,
             RawStatus::AlmostSolved => SolveStatus::AlmostSolved,
-            RawStatus::PrimalInfeasible => return Err(self.infeasible(&raw.z)),
+            RawStatus::PrimalInfeasible => return Err(self.infeasible(&raw.multipliers)),
             RawStatus::DualInfeasible => return Err(PlanError::Unbounded),
             RawStatus::Failed(status) => {
                 return Err(PlanError::SolverFailed {
@@ -157,11 +208,11 @@ impl Planner {
             }
         };
         let k = self.config.horizon;
-        let x = &raw.x;
+        let x = &raw.primal;
         let states: Vec<State> = (0..=k)
             .map(|i| {
                 let o = state_index(i);
-                State::from_array([x[o] + self.data.origin, x[o + 1], x[o + 2], x[o + 3]])
+                State::from_array([x[o] + self.qp.origin, x[o + 1], x[o + 2], x[o + 3]])
             })
             .collect();
         let controls: Vec<Control> = (0..k)
@@ -174,10 +225,10 @@ impl Planner {
             })
             .collect();
         let lateral_violation: Vec<f64> = self
-            .data
+            .qp
             .slack_of_step
             .iter()
-            .map(|s| s.map_or(0.0, |j| x[j]))
+            .map(|s| s.map_or(0.0, |j| x[self.qp.slack_column(j)]))
             .collect();
         let features = features(&states, &controls, &problem.preceding, &problem.adjacent)?;
         #[allow(
@@ -190,7 +241,7 @@ impl Planner {
             .expect("weights and features share the horizon");
         let extras = self.extras(problem, &states, &controls, &lateral_violation);
         Ok(Plan {
-            objective: self.data.objective(x),
+            objective: self.qp.objective(x),
             states,
             controls,
             learned_cost,
@@ -241,12 +292,12 @@ impl Planner {
 
     /// Reads the steps that carry clarabel's primal infeasibility certificate.
     fn infeasible(&self, z: &[f64]) -> PlanError {
-        let m_eq = self.data.m_eq;
+        let m_eq = self.qp.m_eq;
         let scale = z.iter().fold(0.0_f64, |m, v| m.max(v.abs()));
         let threshold = 1e-6 * scale;
         let mut lateral = Vec::new();
         let mut steering = Vec::new();
-        for (tag, &zi) in self.data.row_tags.iter().zip(&z[m_eq..]) {
+        for (tag, &zi) in self.qp.row_tags.iter().zip(&z[m_eq..]) {
             if zi.abs() <= threshold {
                 continue;
             }

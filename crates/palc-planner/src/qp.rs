@@ -1,32 +1,65 @@
-//! Assembly of the sparse QP `min ½ zᵀPz + qᵀz + c  s.t.  A z + s = b, s ∈ {0}^{m_eq} × R_+^{m_in}`.
+//! The lane-change QP in stage form, assembled once from the problem (Eqs. 9-23 and 34):
 //!
-//! Variables are interleaved by step, `z = [X_0, U_0, X_1, U_1, ..., X_K, σ]`, so that the
-//! KKT matrix is banded and a Riccati backend can reuse the layout. `σ` holds one slack
-//! per bounded step in soft mode. Every entry of the sparsity pattern is always written
-//! (zeros included), so the pattern depends only on `K`, the bound pattern, the mode and
-//! whether `s_K` is fixed.
+//! ```text
+//! min Σ_{i<K} ½ ux_iᵀ H_i ux_i + g_iᵀ ux_i + ½ x_Kᵀ H_K x_K + g_Kᵀ x_K + ρ Σ_j σ_j + c
+//! s.t. x_0 = x̂_0 (Eq. 20),   x_{i+1} = A_i x_i + B_i u_i + c_i (Eqs. 11-14),
+//!      E x_K = e (Eq. 21),   coef · ux_i[l] + coef_σ · σ_j <= h (Eqs. 22-23, slacks),
+//! ```
+//!
+//! with `ux_i = [X_i; U_i]`: per step a 6 x 6 cost block (the quadratic features of
+//! Eq. 34 weighted by column `i` of `w`, the acceleration penalty and the tracking
+//! term), the affine dynamics, the fixed `X_0`, the terminal rows, and inequality rows
+//! that each touch one stage variable and at most one soft-bound slack `σ`.
+//!
+//! This is the one assembly: the Riccati backend reads it as it is, and the clarabel
+//! backend's sparse matrices are derived from it (`sparse_qp.rs`), so both backends
+//! solve the same numbers. The flat variable vector of both backends' results is
+//! `x = [X_0, U_0, X_1, U_1, ..., X_K, σ]` ([`state_index`], [`control_index`],
+//! [`StageQp::slack_column`]) and the rows are `X_0`, dynamics, terminal, inequalities.
 //!
 //! Longitudinal positions are assembled relative to the ego's initial position,
-//! `s̃ = s - s_0` (the variable of `z` is `s̃`, [`QpData::origin`] holds `s_0`): the
-//! squared distances of Eq. 34 and the tracking term then expand around offsets of
-//! tens of metres instead of absolute positions, whose squares (1e18 at 1e9 m) would
-//! cancel in the objective. The feature `s δ` (w7) is kept exact as
-//! `w7 s̃ δ + w7 s_0 δ`, a linear term in `δ`: it is the one feature that depends on
-//! where the plan starts (see [`Problem`]).
+//! `s̃ = s - s_0` (the variable is `s̃`, [`StageQp::origin`] holds `s_0`): the squared
+//! distances of Eq. 34 and the tracking term then expand around offsets of tens of
+//! metres instead of absolute positions, whose squares (1e18 at 1e9 m) would cancel in
+//! the objective. The feature `s δ` (w7) is kept exact as `w7 s̃ δ + w7 s_0 δ`, a linear
+//! term in `δ`: it is the one feature that depends on where the plan starts (see
+//! [`Problem`]).
 
+use nalgebra::{Matrix4, Matrix4x2, Matrix6, Vector4, Vector6};
+
+use crate::riccati::StepDynamics;
 use crate::{LateralBoundsMode, PlannerConfig, Problem, feature};
 
-/// Offset of `X_i` in `z`.
+/// States per step (`[s, v, l, φ]`, Eq. 9).
+pub(crate) const NX: usize = 4;
+/// Controls per step (`[a, δ]`, Eq. 10).
+pub(crate) const NU: usize = 2;
+/// Variables per stage (state and control).
+pub(crate) const NZ: usize = NX + NU;
+/// Most inequality rows one slack is in (above, below, `σ >= 0`).
+pub(crate) const MAX_SLACK_ROWS: usize = 3;
+
+/// Local indices of the stage variables in `ux_i = [s, v, l, φ, a, δ]`.
+mod local {
+    pub const S: usize = 0;
+    pub const V: usize = 1;
+    pub const L: usize = 2;
+    pub const PHI: usize = 3;
+    pub const A: usize = 4;
+    pub const DELTA: usize = 5;
+}
+
+/// Offset of `X_i` in the flat variable vector.
 pub(crate) fn state_index(step: usize) -> usize {
-    6 * step
+    NZ * step
 }
 
-/// Offset of `U_i` in `z`.
+/// Offset of `U_i` in the flat variable vector.
 pub(crate) fn control_index(step: usize) -> usize {
-    6 * step + 4
+    NZ * step + NX
 }
 
-/// What decides the sparsity pattern of P and A for a fixed configuration.
+/// What decides the sparsity pattern of the QP for a fixed configuration.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub(crate) struct Pattern {
     /// Per step `0..=K`: (lower bound present, upper bound present).
@@ -43,216 +76,280 @@ pub(crate) enum RowTag {
     Slack,
 }
 
-/// Triplets in a fixed order plus the vectors; rebuilt for each plan (cheap), then
-/// scattered into a cached CSC pattern.
-#[derive(Debug, Default)]
-pub(crate) struct QpData {
-    pub n: usize,
-    pub m_eq: usize,
-    pub m_in: usize,
-    pub p_rows: Vec<usize>,
-    pub p_cols: Vec<usize>,
-    pub p_vals: Vec<f64>,
-    pub a_rows: Vec<usize>,
-    pub a_cols: Vec<usize>,
-    pub a_vals: Vec<f64>,
-    pub q: Vec<f64>,
-    pub b: Vec<f64>,
-    /// Constant dropped from the quadratic form (squared-distance and tracking constants).
-    pub constant: f64,
-    /// `s_0`: the longitudinal variables of `z` are `s - s_0`.
-    pub origin: f64,
-    /// Tag of each inequality row (index `row - m_eq`).
-    pub row_tags: Vec<RowTag>,
-    /// Slack variable of each step in soft mode.
-    pub slack_of_step: Vec<Option<usize>>,
+/// `X_{i+1} = A X_i + B U_i + c` (Eqs. 11-14); `sparse` holds `A` and `B` in the
+/// cheapest exact form for the products of the recursion.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Dynamics {
+    pub c: Vector4<f64>,
+    pub sparse: StepDynamics,
 }
 
-impl QpData {
-    fn p(&mut self, r: usize, c: usize, v: f64) {
-        debug_assert!(r <= c);
-        self.p_rows.push(r);
-        self.p_cols.push(c);
-        self.p_vals.push(v);
-    }
+/// One inequality row `coef · ux[core] + slack_coef · σ[slack] <= h`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Inequality {
+    /// `(stage, local index in [X; U])` of the stage variable, if any.
+    pub core: Option<(usize, usize)>,
+    pub coef: f64,
+    /// Index of the slack variable, if any.
+    pub slack: Option<usize>,
+    pub slack_coef: f64,
+    pub h: f64,
+}
 
-    fn a(&mut self, r: usize, c: usize, v: f64) {
-        self.a_rows.push(r);
-        self.a_cols.push(c);
-        self.a_vals.push(v);
+impl Inequality {
+    /// `(G x)_j` of this row for the stage variables `ux` and the slacks `σ`.
+    #[inline(always)]
+    pub fn times(&self, ux: &[Vector6<f64>], sigma: &[f64]) -> f64 {
+        self.core.map_or(0.0, |(i, l)| self.coef * ux[i][l])
+            + self.slack.map_or(0.0, |k| self.slack_coef * sigma[k])
     }
+}
 
-    /// Fills the QP of Eqs. (11)-(23) (+ extras) for a validated problem.
+/// The QP of one plan in stage form; buffers reused between plans.
+#[derive(Debug, Default)]
+pub(crate) struct StageQp {
+    /// Horizon `K`.
+    pub k: usize,
+    /// Cost Hessian block of stage `i` over `[X_i; U_i]` (`K + 1` blocks; the last has
+    /// only its state corner).
+    pub hessian: Vec<Matrix6<f64>>,
+    /// Linear cost of stage `i` (`K + 1`).
+    pub linear: Vec<Vector6<f64>>,
+    /// Dynamics of steps `0..K`.
+    pub dynamics: Vec<Dynamics>,
+    /// The fixed initial state (`s̃_0 = 0`).
+    pub x0: Vector4<f64>,
+    /// Number of terminal rows `m <= 4`.
+    pub terminal_rows: usize,
+    /// `E` (rows `0..m`).
+    pub terminal: Matrix4<f64>,
+    /// `e` (entries `0..m`).
+    pub terminal_rhs: Vector4<f64>,
+    /// Linear cost of each slack.
+    pub slack_cost: Vec<f64>,
+    /// The stage variable each slack is tied to by its rows.
+    pub slack_core: Vec<Option<(usize, usize)>>,
+    /// The inequality rows of each slack (at most [`MAX_SLACK_ROWS`], first; the unused
+    /// entries `None`).
+    pub slack_rows: Vec<[Option<usize>; MAX_SLACK_ROWS]>,
+    /// Inequality rows: steering (Eq. 23) for every step, then the lateral bounds
+    /// (Eq. 22) step by step, each bounded step's slack row after its bounds.
+    pub inequalities: Vec<Inequality>,
+    /// What each inequality row constrains.
+    pub row_tags: Vec<RowTag>,
+    /// The slack of each step `0..=K` (soft mode, bounded steps only).
+    pub slack_of_step: Vec<Option<usize>>,
+    /// Equality rows `m_eq = 4 + 4K + m`.
+    pub m_eq: usize,
+    /// The constant of the objective (squared-distance and tracking constants).
+    pub constant: f64,
+    /// `s_0`: the longitudinal variables are `s - s_0`.
+    pub origin: f64,
+}
+
+impl StageQp {
+    /// Fills the QP of Eqs. (11)-(23) (+ extras) for a validated problem, reusing the
+    /// buffers.
     pub fn assemble(&mut self, config: &PlannerConfig, problem: &Problem) {
+        use local::{A, DELTA, L, PHI, S, V};
         let k = config.horizon;
         let dt = config.dt;
-        let pattern = pattern_of(problem);
         let soft_weight = match config.lateral_bounds_mode {
             LateralBoundsMode::Soft { weight } => Some(weight),
             LateralBoundsMode::Hard => None,
         };
-        self.p_rows.clear();
-        self.p_cols.clear();
-        self.p_vals.clear();
-        self.a_rows.clear();
-        self.a_cols.clear();
-        self.a_vals.clear();
+        self.k = k;
+        reset(&mut self.hessian, k + 1, Matrix6::zeros());
+        reset(&mut self.linear, k + 1, Vector6::zeros());
+        self.dynamics.clear();
+        self.inequalities.clear();
         self.row_tags.clear();
         self.slack_of_step.clear();
-        let n_core = 6 * k + 4;
-        let mut n = n_core;
-        for &(lo, hi) in &pattern.lateral {
-            if soft_weight.is_some() && (lo || hi) {
-                self.slack_of_step.push(Some(n));
-                n += 1;
-            } else {
-                self.slack_of_step.push(None);
-            }
-        }
-        self.n = n;
-        self.q.clear();
-        self.q.resize(n, 0.0);
+        self.slack_cost.clear();
+        self.slack_core.clear();
+        self.slack_rows.clear();
         self.constant = 0.0;
         let origin = problem.initial.s;
         self.origin = origin;
+        for bound in &problem.lateral_bounds {
+            let bounded = bound.is_some_and(|b| b.min.is_some() || b.max.is_some());
+            match soft_weight.filter(|_| bounded) {
+                Some(weight) => {
+                    self.slack_of_step.push(Some(self.slack_cost.len()));
+                    self.slack_cost.push(weight);
+                }
+                None => self.slack_of_step.push(None),
+            }
+        }
 
-        // Eq. (15) with Eqs. (16)-(19), stage i uses X_{i-1}, U_{i-1} and column i-1.
-        for (stage0, w) in problem.weights.columns().iter().enumerate() {
-            let x = state_index(stage0);
-            let u = control_index(stage0);
-            let (mut pre, mut adj) = (problem.preceding[stage0], problem.adjacent[stage0]);
+        // Eq. (15) with Eqs. (16)-(19) and (34): stage i uses X_{i-1}, U_{i-1} and
+        // column i-1 of w.
+        for (stage, w) in problem.weights.columns().iter().enumerate() {
+            let (mut pre, mut adj) = (problem.preceding[stage], problem.adjacent[stage]);
             pre.s -= origin;
             adj.s -= origin;
             let (w9, w10) = (w[feature::DIST_PRECEDING], w[feature::DIST_ADJACENT]);
-            self.p(x, x, 2.0 * (w9 + w10));
-            self.p(x + 2, x + 2, 2.0 * (w[feature::L_SQUARED] + w9 + w10));
-            self.p(x + 3, x + 3, 2.0 * w[feature::PHI_SQUARED]);
-            self.p(u, u, 2.0 * config.acceleration_penalty);
-            self.p(u + 1, u + 1, 2.0 * w[feature::DELTA_SQUARED]);
-            self.p(x, u + 1, w[feature::S_DELTA]);
-            self.p(x + 2, u + 1, w[feature::L_DELTA]);
-            self.p(x + 3, u + 1, w[feature::PHI_DELTA]);
-            self.q[x] += -2.0 * (w9 * pre.s + w10 * adj.s);
-            self.q[x + 2] += w[feature::L] - 2.0 * (w9 * pre.l + w10 * adj.l);
-            self.q[x + 3] += w[feature::PHI];
-            self.q[u + 1] += w[feature::S_DELTA] * origin;
+            let h = &mut self.hessian[stage];
+            h[(S, S)] += 2.0 * (w9 + w10);
+            h[(L, L)] += 2.0 * (w[feature::L_SQUARED] + w9 + w10);
+            h[(PHI, PHI)] += 2.0 * w[feature::PHI_SQUARED];
+            h[(A, A)] += 2.0 * config.acceleration_penalty;
+            h[(DELTA, DELTA)] += 2.0 * w[feature::DELTA_SQUARED];
+            for (row, weight) in [
+                (S, w[feature::S_DELTA]),
+                (L, w[feature::L_DELTA]),
+                (PHI, w[feature::PHI_DELTA]),
+            ] {
+                h[(row, DELTA)] += weight;
+                h[(DELTA, row)] += weight;
+            }
+            let g = &mut self.linear[stage];
+            g[S] += -2.0 * (w9 * pre.s + w10 * adj.s);
+            g[L] += w[feature::L] - 2.0 * (w9 * pre.l + w10 * adj.l);
+            g[PHI] += w[feature::PHI];
+            g[DELTA] += w[feature::S_DELTA] * origin;
             self.constant +=
                 w9 * (pre.s * pre.s + pre.l * pre.l) + w10 * (adj.s * adj.s + adj.l * adj.l);
         }
-        // Tracking (form of Eq. 25); the diagonal of every state is always in the pattern.
-        for step in 0..=k {
-            let x = state_index(step);
-            let reference = problem
-                .tracking
-                .as_ref()
-                .and_then(|t| t.reference[step].map(|r| (t.weights, r.to_array())))
-                .map(|(q, mut r)| {
-                    r[0] -= origin;
-                    (q, r)
-                });
-            for c in 0..4 {
-                let (weight, r) = reference.map_or((0.0, 0.0), |(q, r)| (q[c], r[c]));
-                self.p(x + c, x + c, 2.0 * weight);
-                self.q[x + c] += -2.0 * weight * r;
-                self.constant += weight * r * r;
-            }
-        }
-        if let Some(weight) = soft_weight {
-            for &slack in self.slack_of_step.iter().flatten() {
-                self.q[slack] = weight;
+        // Tracking (form of Eq. 25).
+        if let Some(tracking) = &problem.tracking {
+            for (step, reference) in tracking.reference.iter().enumerate().take(k + 1) {
+                let Some(reference) = reference else { continue };
+                let mut r = reference.to_array();
+                r[S] -= origin;
+                for c in 0..NX {
+                    let weight = tracking.weights[c];
+                    self.hessian[step][(c, c)] += 2.0 * weight;
+                    self.linear[step][c] += -2.0 * weight * r[c];
+                    self.constant += weight * r[c] * r[c];
+                }
             }
         }
 
         // Equality rows: X_0 (Eq. 20), dynamics (Eqs. 11-14), terminal (Eq. 21).
-        self.b.clear();
-        let mut x0 = problem.initial.to_array();
-        x0[0] = 0.0;
-        for c in 0..4 {
-            self.a(c, c, 1.0);
-            self.b.push(x0[c]);
-        }
+        self.x0 = Vector4::from(problem.initial.to_array());
+        self.x0[S] = 0.0;
         let steer_gain = dt / config.wheelbase;
         for i in 0..k {
-            let r = 4 + 4 * i;
-            let (x, u, next) = (state_index(i), control_index(i), state_index(i + 1));
             let v_ref = problem.reference_speed[i];
-            for c in 0..4 {
-                self.a(r + c, next + c, 1.0);
-                self.a(r + c, x + c, -1.0);
-            }
-            self.a(r, x + 1, -dt); // s' = v
-            self.a(r + 1, u, -dt); // v' = a
-            self.a(r + 2, x + 3, -dt * v_ref); // l' = v_ref φ
-            self.a(r + 3, u + 1, -steer_gain * v_ref); // φ' = v_ref/l_fr δ - v_ref R
-            self.b
-                .extend_from_slice(&[0.0, 0.0, 0.0, -dt * v_ref * problem.curvature]);
+            let mut a = Matrix4::identity();
+            a[(S, V)] = dt; // s' = v
+            a[(L, PHI)] = dt * v_ref; // l' = v_ref φ
+            let mut b = Matrix4x2::zeros();
+            b[(V, A - NX)] = dt; // v' = a
+            b[(PHI, DELTA - NX)] = steer_gain * v_ref; // φ' = v_ref/l_fr δ - v_ref R
+            self.dynamics.push(Dynamics {
+                c: Vector4::new(0.0, 0.0, 0.0, -dt * v_ref * problem.curvature),
+                sparse: StepDynamics::new(&a, &b),
+            });
         }
-        let mut r = 4 + 4 * k;
-        let xk = state_index(k);
         let t = &problem.terminal;
         let terminal = [
-            (t.s.map(|s| s - origin), 0),
-            (Some(t.v), 1),
-            (Some(t.l), 2),
-            (Some(0.0), 3),
+            (t.s.map(|s| s - origin), S),
+            (Some(t.v), V),
+            (Some(t.l), L),
+            (Some(0.0), PHI),
         ];
+        self.terminal = Matrix4::zeros();
+        self.terminal_rhs = Vector4::zeros();
+        self.terminal_rows = 0;
         for (value, c) in terminal {
             if let Some(value) = value {
-                self.a(r, xk + c, 1.0);
-                self.b.push(value);
-                r += 1;
+                self.terminal[(self.terminal_rows, c)] = 1.0;
+                self.terminal_rhs[self.terminal_rows] = value;
+                self.terminal_rows += 1;
             }
         }
-        self.m_eq = r;
+        self.m_eq = NX + NX * k + self.terminal_rows;
 
-        // Inequality rows A z <= b: steering (Eq. 23), lateral (Eq. 22), slacks.
+        // Inequality rows: steering (Eq. 23), lateral (Eq. 22), slacks.
         for i in 0..k {
-            let d = control_index(i) + 1;
-            self.a(r, d, 1.0);
-            self.b.push(config.steering_max);
-            self.a(r + 1, d, -1.0);
-            self.b.push(-config.steering_min);
-            self.row_tags
-                .extend([RowTag::Steering(i), RowTag::Steering(i)]);
-            r += 2;
+            for (coef, h) in [(1.0, config.steering_max), (-1.0, -config.steering_min)] {
+                self.inequalities.push(Inequality {
+                    core: Some((i, DELTA)),
+                    coef,
+                    slack: None,
+                    slack_coef: 0.0,
+                    h,
+                });
+                self.row_tags.push(RowTag::Steering(i));
+            }
         }
         for (step, bound) in problem.lateral_bounds.iter().enumerate() {
             let Some(bound) = bound else { continue };
-            let l = state_index(step) + 2;
             let slack = self.slack_of_step[step];
+            let mut rows = [None; MAX_SLACK_ROWS];
+            let mut add = |qp: &mut Self, row: Inequality, tag| {
+                if let Some(free) = rows.iter_mut().find(|r| r.is_none()) {
+                    *free = Some(qp.inequalities.len());
+                }
+                qp.inequalities.push(row);
+                qp.row_tags.push(tag);
+            };
             for (value, sign) in [(bound.max, 1.0), (bound.min, -1.0)] {
                 if let Some(value) = value {
-                    self.a(r, l, sign);
-                    if let Some(slack) = slack {
-                        self.a(r, slack, -1.0);
-                    }
-                    self.b.push(sign * value);
-                    self.row_tags.push(RowTag::Lateral(step));
-                    r += 1;
+                    let row = Inequality {
+                        core: Some((step, L)),
+                        coef: sign,
+                        slack,
+                        slack_coef: if slack.is_some() { -1.0 } else { 0.0 },
+                        h: sign * value,
+                    };
+                    add(self, row, RowTag::Lateral(step));
                 }
             }
-            if let Some(slack) = slack {
-                self.a(r, slack, -1.0);
-                self.b.push(0.0);
-                self.row_tags.push(RowTag::Slack);
-                r += 1;
+            if slack.is_some() {
+                let row = Inequality {
+                    core: None,
+                    coef: 0.0,
+                    slack,
+                    slack_coef: -1.0,
+                    h: 0.0,
+                };
+                add(self, row, RowTag::Slack);
+                self.slack_core.push(Some((step, L)));
+                self.slack_rows.push(rows);
             }
         }
-        self.m_in = r - self.m_eq;
     }
 
-    /// `½ zᵀPz + qᵀz + c` from the assembled (unscaled) data.
-    pub fn objective(&self, z: &[f64]) -> f64 {
-        let mut value = self.constant;
-        for ((&r, &c), &v) in self.p_rows.iter().zip(&self.p_cols).zip(&self.p_vals) {
-            value += if r == c {
-                0.5 * v * z[r] * z[r]
-            } else {
-                v * z[r] * z[c]
-            };
-        }
-        value + self.q.iter().zip(z).map(|(a, b)| a * b).sum::<f64>()
+    /// Number of variables of the flat vector `[X_0, U_0, ..., X_K, σ]`.
+    pub fn n(&self) -> usize {
+        NZ * self.k + NX + self.slack_cost.len()
     }
+
+    /// Column of slack `j` in the flat variable vector.
+    pub fn slack_column(&self, j: usize) -> usize {
+        NZ * self.k + NX + j
+    }
+
+    /// `½ xᵀPx + qᵀx + c` of a flat variable vector `x` (length [`n`](Self::n)).
+    pub fn objective(&self, x: &[f64]) -> f64 {
+        let mut value = self.constant;
+        for i in 0..=self.k {
+            let size = if i < self.k { NZ } else { NX };
+            let start = state_index(i);
+            let mut ux = Vector6::zeros();
+            for (c, &v) in x[start..start + size].iter().enumerate() {
+                ux[c] = v;
+            }
+            value += 0.5 * ux.dot(&(self.hessian[i] * ux)) + self.linear[i].dot(&ux);
+        }
+        let sigma = &x[self.slack_column(0)..];
+        value
+            + self
+                .slack_cost
+                .iter()
+                .zip(sigma)
+                .map(|(c, s)| c * s)
+                .sum::<f64>()
+    }
+}
+
+/// `v` with `n` entries, all `value` (allocates only when `n` grows past the capacity).
+fn reset<T: Copy>(v: &mut Vec<T>, n: usize, value: T) {
+    v.clear();
+    v.resize(n, value);
 }
 
 /// The sparsity-deciding part of a problem.
@@ -264,58 +361,5 @@ pub(crate) fn pattern_of(problem: &Problem) -> Pattern {
             .map(|b| b.map_or((false, false), |b| (b.min.is_some(), b.max.is_some())))
             .collect(),
         terminal_s: problem.terminal.s.is_some(),
-    }
-}
-
-/// A compressed-sparse-column pattern built once from triplets, with the position of
-/// each triplet in `nzval` (duplicates share a position and are summed); only the
-/// clarabel backend reads the QP in this form.
-#[cfg(feature = "clarabel")]
-#[derive(Debug, Clone)]
-pub(crate) struct CscPattern {
-    pub m: usize,
-    pub n: usize,
-    pub colptr: Vec<usize>,
-    pub rowval: Vec<usize>,
-    pub slot_of_triplet: Vec<usize>,
-}
-
-#[cfg(feature = "clarabel")]
-impl CscPattern {
-    pub fn new(m: usize, n: usize, rows: &[usize], cols: &[usize]) -> Self {
-        let mut order: Vec<usize> = (0..rows.len()).collect();
-        order.sort_unstable_by_key(|&t| (cols[t], rows[t]));
-        let mut colptr = vec![0; n + 1];
-        let mut rowval = Vec::with_capacity(rows.len());
-        let mut slot_of_triplet = vec![0; rows.len()];
-        let mut last: Option<(usize, usize)> = None;
-        for &t in &order {
-            let key = (cols[t], rows[t]);
-            if last != Some(key) {
-                rowval.push(rows[t]);
-                colptr[cols[t] + 1] += 1;
-                last = Some(key);
-            }
-            slot_of_triplet[t] = rowval.len() - 1;
-        }
-        for c in 0..n {
-            colptr[c + 1] += colptr[c];
-        }
-        Self {
-            m,
-            n,
-            colptr,
-            rowval,
-            slot_of_triplet,
-        }
-    }
-
-    /// Scatters triplet values into `nzval` (summing duplicates).
-    pub fn scatter(&self, values: &[f64], nzval: &mut Vec<f64>) {
-        nzval.clear();
-        nzval.resize(self.rowval.len(), 0.0);
-        for (&slot, &v) in self.slot_of_triplet.iter().zip(values) {
-            nzval[slot] += v;
-        }
     }
 }

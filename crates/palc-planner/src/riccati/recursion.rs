@@ -26,30 +26,11 @@
 
 use nalgebra::{Matrix2, Matrix2x4, Matrix4, Matrix6, Vector2, Vector4, Vector6};
 
-use super::stage_qp::{Dynamics, NX};
-
-/// Static regularization added to every `R̄` (absolute, on top of a relative 1e-13):
-/// keeps the recursion defined when the acceleration has no cost of its own.
-const CONTROL_REGULARIZATION: f64 = 1e-10;
-
-/// Regularization of the terminal Schur complement `-W_0`, relative to each row's own
-/// diagonal. Without an acceleration cost the rows of `s_K` and `v_K` are of order
-/// 1 / CONTROL_REGULARIZATION, ten orders of magnitude above those of `l_K` and `φ_K`;
-/// a regularization relative to the largest row (as before) moved the lateral rows by
-/// 1e-14 times that ratio of their size, the terminal refinement could not restore them,
-/// and the interior point stalled or stopped off the optimum (188 of 384 curved lane
-/// changes without acceleration penalty and with a fixed `s_K`, issue 12).
-const TERMINAL_REGULARIZATION: f64 = 1e-14;
-/// A row whose diagonal is below this fraction of the largest one (a terminal row that
-/// no control reaches, e.g. `l_K` at `K = 1`) is regularized as if it had this size,
-/// so that `-W_0` stays invertible and the infeasibility certificate finite.
-const TERMINAL_FLOOR: f64 = 1e-10;
-
-/// Newton steps on the terminal multiplier after the first forward pass, at most.
-const TERMINAL_REFINEMENTS: usize = 2;
-/// Terminal residual (relative to `1 + ‖x_K‖∞ + ‖e‖∞`) below which no refinement is
-/// done: rounding in the forward pass alone reaches about 1e-14.
-const TERMINAL_TOLERANCE: f64 = 1e-12;
+use super::params::{
+    CONTROL_REGULARIZATION, CONTROL_REGULARIZATION_RELATIVE, TERMINAL_FLOOR, TERMINAL_REFINEMENTS,
+    TERMINAL_REGULARIZATION, TERMINAL_TOLERANCE,
+};
+use crate::qp::{Dynamics, NX};
 
 /// Why a factorization failed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -77,7 +58,7 @@ pub(crate) struct Rhs<'a> {
 /// The solution of one Newton system.
 pub(crate) struct Step<'a> {
     /// `[x_i; u_i]` (`K + 1`, the last control zero).
-    pub z: &'a mut [Vector6<f64>],
+    pub ux: &'a mut [Vector6<f64>],
     /// Multipliers of the dynamics rows (`K`).
     pub y_dynamics: &'a mut [Vector4<f64>],
     /// Multipliers of the initial rows.
@@ -176,7 +157,7 @@ impl Riccati {
             r_bar[(0, 0)] += diag[4];
             r_bar[(1, 1)] += diag[5];
             let scale = r_bar[(0, 0)].abs().max(r_bar[(1, 1)].abs());
-            let reg = CONTROL_REGULARIZATION + 1e-13 * scale;
+            let reg = CONTROL_REGULARIZATION + CONTROL_REGULARIZATION_RELATIVE * scale;
             r_bar[(0, 0)] += reg;
             r_bar[(1, 1)] += reg;
             // Positive definite iff the leading entry and the determinant are positive;
@@ -251,7 +232,7 @@ impl Riccati {
         // interior point cannot otherwise correct.
         for _ in 0..=TERMINAL_REFINEMENTS {
             self.forward(dynamics, rhs, &nu, &mut out);
-            let x_k = out.z[self.k].fixed_rows::<4>(0).into_owned();
+            let x_k = out.ux[self.k].fixed_rows::<4>(0).into_owned();
             let scale = 1.0 + x_k.amax() + rhs.terminal.amax();
             let mut residual = self.terminal * x_k - rhs.terminal;
             for j in self.m..NX {
@@ -272,12 +253,12 @@ impl Riccati {
         for i in 0..k {
             let d = &dynamics[i].sparse;
             let u = self.gain[i] * x + self.k_vec[i] - self.r_inv[i] * (self.bt_gamma[i] * nu);
-            out.z[i].fixed_rows_mut::<4>(0).copy_from(&x);
-            out.z[i].fixed_rows_mut::<2>(4).copy_from(&u);
+            out.ux[i].fixed_rows_mut::<4>(0).copy_from(&x);
+            out.ux[i].fixed_rows_mut::<2>(4).copy_from(&u);
             x = d.a_mul(&x) + d.b_mul(&u) + rhs.offsets[i];
             out.y_dynamics[i] = -(self.p[i + 1] * x + self.p_vec[i + 1] + self.gamma[i + 1] * nu);
         }
-        out.z[k] = Vector6::new(x[0], x[1], x[2], x[3], 0.0, 0.0);
+        out.ux[k] = Vector6::new(x[0], x[1], x[2], x[3], 0.0, 0.0);
         *out.y_terminal = *nu;
     }
 }

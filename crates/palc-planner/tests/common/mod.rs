@@ -8,7 +8,9 @@ use proptest::prelude::*;
 
 #[path = "../../fixtures/lane_change.rs"]
 mod lane_change_fixture;
-pub use lane_change_fixture::lane_change;
+// Not every test binary re-plans.
+#[allow(unused_imports)]
+pub use lane_change_fixture::{lane_change, shifted};
 
 /// Random weights in the convex set: every stage block is PSD by construction
 /// (couplings at most 90 % of what each diagonal can carry against a third of w8).

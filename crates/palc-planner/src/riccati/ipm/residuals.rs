@@ -1,0 +1,180 @@
+//! The residuals of an iterate and the measures the stopping rule reads.
+//!
+//! For the QP of [`variables`](super::variables), the residuals of the KKT conditions
+//! at `(x, s, y, λ)` are
+//!
+//! ```text
+//! r_dual = P x + q + Aᵀ y + Gᵀ λ        (stationarity, per stage and per slack σ),
+//! r_eq   = A x - b                     (X_0 of Eq. 20, dynamics of Eqs. 11-14, Eq. 21),
+//! r_in   = G x + s - h                 (Eqs. 22-23),
+//! ```
+//!
+//! kept in stage form (the dynamics residual negated as the offset `f_i` of the
+//! Riccati right-hand side). One pass over the rows, one over the slacks and one over
+//! the stages also give the objectives, the norms of clarabel's relative measures and
+//! the primal infeasibility certificate `(bᵀy + hᵀλ, ‖Aᵀy + Gᵀλ‖∞)`.
+
+use nalgebra::{Vector4, Vector6};
+
+use super::head;
+use super::info::Measures;
+use super::variables::{Variables, resize_fill};
+use crate::qp::{NX, StageQp};
+
+/// The residuals of the current iterate, in stage form.
+#[derive(Debug, Default)]
+pub(crate) struct Residuals {
+    /// `P x + q` per stage (the gradient of the objective).
+    pub grad: Vec<Vector6<f64>>,
+    /// `r_dual` per stage.
+    pub dual: Vec<Vector6<f64>>,
+    /// `r_dual` per soft-bound slack.
+    pub dual_sigma: Vec<f64>,
+    /// `X_0 - x̂_0`.
+    pub initial: Vector4<f64>,
+    /// `E X_K - e` (entries `0..m`, the others zero).
+    pub terminal: Vector4<f64>,
+    /// `r_in` per inequality row.
+    pub inequality: Vec<f64>,
+    /// `-(X_{i+1} - A_i X_i - B_i U_i - c_i)` per step: the offsets `f_i` of the Riccati
+    /// right-hand side that restore the dynamics in one full Newton step.
+    pub offsets: Vec<Vector4<f64>>,
+    /// `max(‖x̂_0‖∞, ‖c‖∞, ‖e‖∞, ‖h‖∞)`: the data norm of the primal measure.
+    norm_b: f64,
+    /// `‖q‖∞` (stages and slacks): the data norm of the dual measure.
+    norm_q: f64,
+}
+
+impl Residuals {
+    /// Sizes the buffers for `qp` and computes its data norms.
+    pub fn reset(&mut self, qp: &StageQp) {
+        let (k, n_slack, m_in) = (qp.k, qp.slack_cost.len(), qp.inequalities.len());
+        resize_fill(&mut self.grad, k + 1, Vector6::zeros());
+        resize_fill(&mut self.dual, k + 1, Vector6::zeros());
+        resize_fill(&mut self.dual_sigma, n_slack, 0.0);
+        resize_fill(&mut self.inequality, m_in, 0.0);
+        resize_fill(&mut self.offsets, k, Vector4::zeros());
+        self.initial = Vector4::zeros();
+        self.terminal = Vector4::zeros();
+        let m = qp.terminal_rows;
+        self.norm_b = norm_inf(qp.x0.iter())
+            .max(qp.dynamics.iter().fold(0.0, |n, d| n.max(d.c.amax())))
+            .max(norm_inf(qp.terminal_rhs.iter().take(m)))
+            .max(norm_inf(qp.inequalities.iter().map(|r| &r.h)));
+        self.norm_q = qp
+            .linear
+            .iter()
+            .fold(0.0_f64, |n, g| n.max(g.amax()))
+            .max(norm_inf(&qp.slack_cost));
+    }
+
+    /// The residuals of `v` and its convergence measures.
+    pub fn compute(&mut self, qp: &StageQp, v: &Variables) -> Measures {
+        let k = qp.k;
+        let m = qp.terminal_rows;
+        // Pass over the inequalities: Gᵀλ into r_dual, r_in, hᵀλ, norms.
+        self.dual.fill(Vector6::zeros());
+        self.dual_sigma.fill(0.0);
+        let (mut hl, mut norm_s, mut norm_lambda, mut norm_r_in) = (0.0, 0.0_f64, 0.0_f64, 0.0_f64);
+        {
+            let n = qp.inequalities.len();
+            let (lambda, s, r_in) = (&v.lambda[..n], &v.s[..n], &mut self.inequality[..n]);
+            let (dual, dual_sigma) = (&mut self.dual, &mut self.dual_sigma);
+            for (j, row) in qp.inequalities.iter().enumerate() {
+                let (l, s) = (lambda[j], s[j]);
+                if let Some((i, c)) = row.core {
+                    dual[i][c] += row.coef * l;
+                }
+                if let Some(n) = row.slack {
+                    dual_sigma[n] += row.slack_coef * l;
+                }
+                let gx = row.times(&v.ux, &v.sigma);
+                let r = gx + s - row.h;
+                r_in[j] = r;
+                hl += row.h * l;
+                norm_s = norm_s.max(s.abs());
+                norm_lambda = norm_lambda.max(l.abs());
+                norm_r_in = norm_r_in.max(r.abs());
+            }
+        }
+        // Pass over the slacks.
+        let (mut qx, mut certificate_residual, mut dual, mut norm_x) =
+            (0.0, 0.0_f64, 0.0_f64, 0.0_f64);
+        for j in 0..v.sigma.len() {
+            certificate_residual = certificate_residual.max(self.dual_sigma[j].abs());
+            qx += qp.slack_cost[j] * v.sigma[j];
+            self.dual_sigma[j] += qp.slack_cost[j];
+            dual = dual.max(self.dual_sigma[j].abs());
+            norm_x = norm_x.max(v.sigma[j].abs());
+        }
+        // Pass over the stages: Aᵀy, Px, the dynamics residuals, bᵀy, objectives, norms.
+        self.initial = v.ux[0].fixed_rows::<4>(0) - qp.x0;
+        let mut by = qp.x0.dot(&v.y_initial);
+        let mut norm_y = v.y_initial.amax().max(v.y_terminal.amax());
+        let mut primal = self.initial.amax().max(norm_r_in);
+        let mut xpx = 0.0;
+        for i in 0..=k {
+            let incoming = if i == 0 {
+                v.y_initial
+            } else {
+                v.y_dynamics[i - 1]
+            };
+            head(&mut self.dual[i], &incoming);
+            if i < k {
+                let d = &qp.dynamics[i];
+                let y = v.y_dynamics[i];
+                head(&mut self.dual[i], &-d.sparse.a_tr_mul(&y));
+                let mut tail = self.dual[i].fixed_rows_mut::<2>(4);
+                tail -= d.sparse.b_tr_mul(&y);
+                by += d.c.dot(&y);
+                norm_y = norm_y.max(y.amax());
+                let x = v.ux[i].fixed_rows::<4>(0).into_owned();
+                let u = v.ux[i].fixed_rows::<2>(4).into_owned();
+                let r =
+                    v.ux[i + 1].fixed_rows::<4>(0) - d.sparse.a_mul(&x) - d.sparse.b_mul(&u) - d.c;
+                primal = primal.max(r.amax());
+                self.offsets[i] = -r;
+            } else {
+                head(&mut self.dual[k], &qp.terminal.tr_mul(&v.y_terminal));
+            }
+            certificate_residual = certificate_residual.max(self.dual[i].amax());
+            let px = qp.hessian[i] * v.ux[i];
+            xpx += v.ux[i].dot(&px);
+            qx += qp.linear[i].dot(&v.ux[i]);
+            let grad = px + qp.linear[i];
+            self.dual[i] += grad;
+            self.grad[i] = grad;
+            dual = dual.max(self.dual[i].amax());
+            norm_x = norm_x.max(v.ux[i].amax());
+        }
+        for j in 0..m {
+            by += qp.terminal_rhs[j] * v.y_terminal[j];
+        }
+        self.terminal = qp.terminal * v.ux[k].fixed_rows::<4>(0) - qp.terminal_rhs;
+        for j in m..NX {
+            self.terminal[j] = 0.0;
+        }
+        primal = primal.max(self.terminal.amax());
+        let norm_y = norm_y.max(norm_lambda);
+
+        // With the constant, so that the relative gap is relative to the plan's
+        // objective and not to terms that cancel against the constant.
+        let pobj = 0.5 * xpx + qx + qp.constant;
+        let dobj = -0.5 * xpx - by - hl + qp.constant;
+        let gap_abs = (pobj - dobj).abs();
+        Measures {
+            res_primal: primal / (self.norm_b + norm_x + norm_s).max(1.0),
+            res_dual: dual / (self.norm_q + norm_x + norm_y).max(1.0),
+            gap_abs,
+            gap_rel: gap_abs / pobj.abs().min(dobj.abs()).max(1.0),
+            certificate_value: by + hl,
+            certificate_residual,
+            objective: pobj,
+        }
+    }
+}
+
+/// `‖v‖∞`.
+fn norm_inf<'a>(values: impl IntoIterator<Item = &'a f64>) -> f64 {
+    values.into_iter().fold(0.0_f64, |m, v| m.max(v.abs()))
+}
