@@ -335,3 +335,55 @@ fn a_saved_experience_keeps_its_permissions_and_its_symlink() {
     assert_eq!(target.permissions().mode() & 0o777, 0o600);
     palc_aggregator::Experience::load(dir.join("store/e.json")).unwrap();
 }
+
+#[test]
+fn user_expect_writes_the_expected_lane_change_of_a_user_file() {
+    let dir = scratch("user-expect");
+    std::fs::write(
+        dir.join("user.toml"),
+        "[user]\nstyle = \"neutral\"\n[user.family]\nprofile = { shape = \"cosine\" }\nreaction_s = 0.5\n",
+    )
+    .unwrap();
+    let output = palc(
+        &[
+            "user",
+            "expect",
+            "--user",
+            "user.toml",
+            "--out",
+            "expected.csv",
+        ],
+        &dir,
+    );
+    succeeds(&output);
+    let csv = std::fs::read_to_string(dir.join("expected.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("step,time_s,s_m,v_mps,l_m,phi_rad,phase")
+    );
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let l = |row: &Vec<&str>| row[4].parse::<f64>().unwrap();
+    assert!(l(&rows[0]).abs() < 1e-9);
+    assert!((l(rows.last().unwrap()) - 3.5).abs() < 1e-3);
+    assert!(rows.iter().any(|r| r[6] == "changing"));
+    // A bad user file names the file and the field; no CSV is left behind.
+    std::fs::write(
+        dir.join("bad.toml"),
+        "[user]\nstyle = \"neutral\"\nfamily = { reaction_s = 9.0 }\n",
+    )
+    .unwrap();
+    let output = palc(
+        &["user", "expect", "--user", "bad.toml", "--out", "bad.csv"],
+        &dir,
+    );
+    fails_with(
+        &output,
+        &["bad.toml", "user.family.reaction_s", "[0.0, 3.0]"],
+    );
+    assert!(!dir.join("bad.csv").exists());
+    // `palc learn --user` reads the same files.
+    succeeds(&palc(&["learn", "--user", "user.toml"], &dir));
+    let output = palc(&["learn", "--user", "bad.toml"], &dir);
+    fails_with(&output, &["bad.toml", "user.family.reaction_s"]);
+}
