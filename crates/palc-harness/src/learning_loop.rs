@@ -13,6 +13,7 @@ use palc_aggregator::{
 use palc_planner::{LateralBoundsMode, Plan, Planner, PlannerConfig, Problem};
 
 use crate::HarnessError;
+use crate::closed_loop::ClosedLoop;
 use crate::config::{LearnConfig, StoppingConfig};
 use crate::drive::{Drive, execute, plan_safety, problem};
 use crate::learn::{RunResult, aggregator_options, prepare};
@@ -59,6 +60,8 @@ pub struct LearningLoop {
     /// With the safety layer on, the standard ALC's plan and its predicted safety
     /// (checked safe): what the layer drives when it refuses `next_plan`.
     fallback: Option<(Plan, SafetyMetrics)>,
+    /// With `[planning.closed_loop]` on, the closed-loop driver.
+    closed_loop: Option<ClosedLoop>,
     /// Compute time of the step that produced `next_plan`.
     pending_times: Timings,
     records: Vec<LaneChangeRecord>,
@@ -136,6 +139,7 @@ impl LearningLoop {
             &scenes(&setup, None),
             &options,
         )?;
+        let closed_loop = ClosedLoop::for_config(config, &setup, planner.config())?;
         let started = Instant::now();
         let next_plan = planner.plan(&first_problem)?;
         let pending_times = Timings {
@@ -156,6 +160,7 @@ impl LearningLoop {
             experience,
             next_plan,
             fallback,
+            closed_loop,
             pending_times,
             records: Vec::new(),
             takeovers: 0,
@@ -180,6 +185,20 @@ impl LearningLoop {
     pub fn step(&mut self, observer: &mut dyn Observer) -> Result<&LaneChangeRecord, HarnessError> {
         let index = self.records.len();
         let (plan, planned_safety, refusal) = self.checked_plan()?;
+        let (plan, closed_loop) = match &self.closed_loop {
+            Some(driver) => {
+                let (plan, stats) = driver.drive(
+                    &self.setup,
+                    &self.experience,
+                    &self.options,
+                    &plan,
+                    refusal.is_some(),
+                )?;
+                (plan, Some(stats))
+            }
+            None => (plan, None),
+        };
+        let refusal = refusal.or(closed_loop.and_then(|c| c.first_refusal));
         if let Some(violation) = &refusal {
             observer.safety_refusal(index, violation);
         }
@@ -187,6 +206,7 @@ impl LearningLoop {
         let mut record = self.record(&drive);
         record.planned_safety = planned_safety;
         record.safety_refusal = refusal;
+        record.closed_loop = closed_loop;
         observer.lane_change(&record);
         self.records.push(record);
         self.pending_times = Timings::default();
@@ -317,6 +337,7 @@ impl LearningLoop {
             user_safety: drive.user_safety,
             planned_safety: SafetyMetrics::default(),
             safety_refusal: None,
+            closed_loop: None,
             learning_error: None,
         }
     }
@@ -512,6 +533,7 @@ mod tests {
             user_safety: SafetyMetrics::default(),
             planned_safety: SafetyMetrics::default(),
             safety_refusal: None,
+            closed_loop: None,
             learning_error: None,
         }
     }
