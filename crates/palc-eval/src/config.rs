@@ -31,12 +31,25 @@ pub struct EvalConfig {
     pub users: Vec<UserKind>,
     /// Experience accumulation (Fig. 11).
     pub transfer: TransferConfig,
+    /// Closed-loop execution: grid cells run again with re-planning on; none if absent.
+    #[serde(default)]
+    pub closed_loop: ClosedLoopRuns,
     /// Compute time against horizon and step (Fig. 13).
     pub timing: TimingConfig,
     /// The qualitative example (Fig. 6).
     pub example: ExampleConfig,
     /// The `--quick` subset.
     pub quick: QuickConfig,
+}
+
+/// Closed-loop execution (`[closed_loop]`): every grid cell of these users run
+/// again, for every method, with the base config's `[planning.closed_loop]`
+/// turned on, against the same cell in open loop.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClosedLoopRuns {
+    /// Names of the user kinds to run it for.
+    pub users: Vec<String>,
 }
 
 /// The grid of Section III: every combination is one run.
@@ -169,6 +182,9 @@ pub struct QuickConfig {
     pub users: Vec<String>,
     /// The quick timing experiment.
     pub timing: TimingConfig,
+    /// The quick closed-loop experiment (on the quick grid); none if absent.
+    #[serde(default)]
+    pub closed_loop: ClosedLoopRuns,
 }
 
 /// What one invocation runs: the full evaluation or the quick subset.
@@ -180,6 +196,8 @@ pub struct Selection {
     pub users: Vec<UserKind>,
     /// The transfer experiment.
     pub transfer: TransferConfig,
+    /// The closed-loop experiment.
+    pub closed_loop: ClosedLoopRuns,
     /// The timing experiment.
     pub timing: TimingConfig,
     /// The example.
@@ -217,6 +235,7 @@ impl EvalConfig {
                 grid: self.grid.resolve("grid", testbed)?,
                 users: self.users.clone(),
                 transfer: self.transfer.clone(),
+                closed_loop: self.closed_loop.clone(),
                 timing: self.timing.clone(),
                 example: self.example.clone(),
             });
@@ -235,6 +254,7 @@ impl EvalConfig {
             grid: self.quick.grid.resolve("quick.grid", testbed)?,
             users,
             transfer,
+            closed_loop: self.quick.closed_loop.clone(),
             timing: self.quick.timing.clone(),
             example: self.example.clone(),
         })
@@ -286,6 +306,18 @@ impl EvalConfig {
         }
         for name in &self.quick.users {
             self.user(name, "quick.users")?;
+        }
+        for name in &self.closed_loop.users {
+            self.user(name, "closed_loop.users")?;
+        }
+        for name in &self.quick.closed_loop.users {
+            if !self.quick.users.contains(name) {
+                return Err(EvalError::invalid(
+                    "quick.closed_loop.users",
+                    format_args!("`{name}`"),
+                    "a user kind of quick.users",
+                ));
+            }
         }
         if self.quick.users.is_empty() {
             return Err(EvalError::invalid(
