@@ -1,7 +1,8 @@
 //! The re-plan that the benchmark and the latency example time: the project's
-//! learn config with its horizon stretched to K = 121 steps, an aggressive user's
-//! experience after two lessons (weights and zone), and the first closed-loop
-//! re-plan, one step into the lane change, so that it plans K − 1 = 120 steps.
+//! learn config (its horizon stretched when shorter than 121 steps), an
+//! aggressive user's experience after two lessons (weights and zone), and the
+//! closed-loop re-plan `K − 120` steps into the lane change, so that it plans the
+//! remaining 120 steps.
 
 use palc_aggregator::{AggregatorOptions, Experience};
 use palc_harness::closed_loop::{ClosedLoop, Policy, Replan};
@@ -20,6 +21,7 @@ pub struct Fixture {
     pub options: AggregatorOptions,
     pub scene: Scene,
     pub tail: Vec<State>,
+    pub step: usize,
 }
 
 impl Fixture {
@@ -29,10 +31,13 @@ impl Fixture {
             .expect("the project's config")
             .with_user(UserConfig::preset(StylePreset::Aggressive));
         let horizon = palc_harness::prepare(&config).expect("a scenario").horizon;
-        let extra = (REPLAN_STEPS + 1) as f64 - horizon as f64;
-        config.planning.horizon_margin_s += extra * config.planning.dt;
-        let setup = palc_harness::prepare(&config).expect("the stretched scenario");
-        assert_eq!(setup.horizon, REPLAN_STEPS + 1);
+        if horizon <= REPLAN_STEPS {
+            let extra = (REPLAN_STEPS + 1 - horizon) as f64;
+            config.planning.horizon_margin_s += extra * config.planning.dt;
+        }
+        let setup = palc_harness::prepare(&config).expect("the scenario");
+        let step = setup.horizon - REPLAN_STEPS;
+        assert!(step >= 1);
         let mut run = LearningLoop::new(&config, None).expect("a loop");
         for _ in 0..2 {
             run.step(&mut NoObserver).expect("a lane change");
@@ -47,25 +52,23 @@ impl Fixture {
         };
         let driver = ClosedLoop::new(planner, 1, None).expect("a driver");
         let mut scene = setup.scene.clone();
-        let first = plan.states[1];
-        scene
-            .step(
-                setup.dt,
-                EgoState {
-                    s: first.s + setup.origin_s,
-                    l: first.l,
-                    v: first.v,
-                    heading: first.phi,
-                },
-            )
-            .expect("a step");
+        for state in &plan.states[1..=step] {
+            let ego = EgoState {
+                s: state.s + setup.origin_s,
+                l: state.l,
+                v: state.v,
+                heading: state.phi,
+            };
+            scene.step(setup.dt, ego).expect("a step");
+        }
         Fixture {
             driver,
             setup,
             experience,
             options,
             scene,
-            tail: plan.states[1..].to_vec(),
+            tail: plan.states[step..].to_vec(),
+            step,
         }
     }
 
@@ -78,7 +81,7 @@ impl Fixture {
                 &self.options,
                 &self.scene,
                 &self.tail,
-                1,
+                self.step,
                 Policy::Learned,
             )
             .expect("a re-plan")

@@ -109,6 +109,20 @@ fn the_replan_period_is_checked_naming_the_field() {
     .unwrap();
     let base = LearnConfig::from_toml_str(&text).unwrap();
     assert!(!base.planning.closed_loop.enabled);
+    // Disabled, the period need not be a multiple of the step (the timing
+    // experiment runs at 0.2 s), but it must still be a period.
+    let with = text.replace("replan_period_s = 0.1 ", "replan_period_s = 0.15 ");
+    LearnConfig::from_toml_str(&with).unwrap();
+    let with = text.replace("replan_period_s = 0.1 ", "replan_period_s = -1.0 ");
+    let err = LearnConfig::from_toml_str(&with).unwrap_err().to_string();
+    assert!(
+        err.contains("planning.closed_loop.replan_period_s"),
+        "{err}"
+    );
+    let text = text.replace(
+        "enabled = false                    # off: one plan",
+        "enabled = true # one plan",
+    );
     for (period, bound) in [
         ("0.0", "> 0"),
         ("-0.1", "> 0"),
