@@ -119,3 +119,55 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method], users: &[S
     }
     let _ = writeln!(out);
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plan::{Experiment, expand};
+    use crate::results::Status;
+
+    /// Grid and closed-loop rows of the test selection's deterministic users,
+    /// the closed-loop ones personalized after `closed_takeovers` takeovers.
+    fn rows(closed_takeovers: usize) -> Vec<RunRow> {
+        let mut selection = crate::plan::tests::selection();
+        selection.closed_loop.users = vec!["deterministic".into()];
+        let plan = expand(&selection, &crate::plan::tests::testbed()).unwrap();
+        plan.all()
+            .map(|spec| {
+                let mut row = RunRow::without_result(spec.clone(), Status::Personalized, 30, 0.0);
+                row.takeovers = match spec.experiment {
+                    Experiment::ClosedLoop => closed_takeovers,
+                    _ => 2,
+                };
+                row
+            })
+            .collect()
+    }
+
+    #[test]
+    fn closed_loop_runs_are_compared_with_the_same_cells_in_open_loop() {
+        let users = ["deterministic".to_owned(), "spread".to_owned()];
+        let methods = [Method::Paper, Method::Palc];
+        let mut out = String::new();
+        section(&mut out, &rows(2), &methods, &users);
+        assert!(out.contains("## Closed-loop execution"), "{out}");
+        // One line per method, for the deterministic users only.
+        assert_eq!(out.matches("| deterministic |").count(), 2, "{out}");
+        assert!(!out.contains("| spread |"), "{out}");
+        assert_eq!(out.matches("like open loop").count(), 2, "{out}");
+        assert!(out.contains("100.0 % / 100.0 %"), "{out}");
+
+        let mut out = String::new();
+        section(&mut out, &rows(3), &methods, &users);
+        assert!(out.contains("2.00 / 3.00"), "{out}");
+        assert_eq!(out.matches("| differs |").count(), 2, "{out}");
+
+        // Without closed-loop runs there is no section.
+        let open: Vec<RunRow> = (rows(2).into_iter())
+            .filter(|r| r.spec.experiment != Experiment::ClosedLoop)
+            .collect();
+        let mut out = String::new();
+        section(&mut out, &open, &methods, &users);
+        assert!(out.is_empty());
+    }
+}

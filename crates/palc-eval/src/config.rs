@@ -483,6 +483,30 @@ mod tests {
     }
 
     #[test]
+    fn closed_loop_users_are_known_and_the_quick_ones_run_in_the_quick_subset() {
+        let config = project_config();
+        assert_eq!(config.closed_loop.users, vec!["deterministic".to_owned()]);
+        let quick = config.select(true, &testbed()).unwrap();
+        assert_eq!(quick.closed_loop.users, vec!["deterministic".to_owned()]);
+        let mut bad = project_config();
+        bad.closed_loop.users = vec!["nobody".into()];
+        let error = bad.validate().unwrap_err().to_string();
+        assert!(error.contains("closed_loop.users"), "{error}");
+        let mut bad = project_config();
+        bad.quick.closed_loop.users = vec!["spread-2%".into()];
+        bad.quick.users = vec!["deterministic".into()];
+        let error = bad.validate().unwrap_err().to_string();
+        assert!(error.contains("quick.closed_loop.users"), "{error}");
+        // A config without the table runs no closed-loop run.
+        let without = PROJECT_CONFIG
+            .replace("[closed_loop]\nusers = [\"deterministic\"]\n", "")
+            .replace("[quick.closed_loop]\nusers = [\"deterministic\"]\n", "");
+        assert_ne!(without, PROJECT_CONFIG);
+        let config = EvalConfig::from_toml_str(&without).unwrap();
+        assert!(config.closed_loop.users.is_empty());
+    }
+
+    #[test]
     fn a_bad_value_is_named() {
         let error = EvalConfig::from_toml_str(&PROJECT_CONFIG.replace(
             "methods = [\"paper\", \"palc\"]",
