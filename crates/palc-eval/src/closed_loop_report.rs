@@ -17,9 +17,12 @@ pub const SUCCESS_POINTS: f64 = 2.0;
 /// open loop.
 pub const MEAN_TAKEOVERS: f64 = 0.5;
 
+/// The grid row and the closed-loop row of one cell.
+type Pair<'a> = (&'a RunRow, &'a RunRow);
+
 /// Writes the section when there are closed-loop runs.
 pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method], users: &[String]) {
-    let tables: Vec<(Method, &String, Vec<(&RunRow, &RunRow)>)> = (methods.iter())
+    let tables: Vec<(Method, &String, Vec<Pair>)> = (methods.iter())
         .flat_map(|&m| users.iter().map(move |u| (m, u)))
         .map(|(m, u)| (m, u, closed_loop_pairs(rows, m, u)))
         .filter(|(_, _, pairs)| !pairs.is_empty())

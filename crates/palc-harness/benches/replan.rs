@@ -4,11 +4,11 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 
-#[path = "fixture.rs"]
+#[path = "common/fixture.rs"]
 mod fixture;
 
 fn replan(c: &mut Criterion) {
-    let fixture = fixture::Fixture::new();
+    let fixture = fixture::Fixture::load();
     assert!(matches!(
         fixture.replan(),
         palc_harness::closed_loop::Replan::Drive(_)

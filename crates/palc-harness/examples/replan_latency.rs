@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-#[path = "../benches/fixture.rs"]
+#[path = "../benches/common/fixture.rs"]
 mod fixture;
 
 fn main() {
@@ -12,7 +12,7 @@ fn main() {
         .ok()
         .and_then(|t| t.parse().ok())
         .unwrap_or(1000usize);
-    let fixture = fixture::Fixture::new();
+    let fixture = fixture::Fixture::load();
     let mut times = Vec::with_capacity(replans);
     let mut planning = Vec::with_capacity(replans);
     for _ in 0..replans {

@@ -413,13 +413,16 @@ impl ClosedLoop {
     }
 }
 
+/// `(s − origin_s, l)` of a vehicle per step.
+type Positions = Vec<[f64; 2]>;
+
 /// Predicted preceding and adjacent vehicles `(s − origin_s, l)` at the steps of
 /// `tail`, from a copy of `scene` in which the ego drives `tail`.
 fn predict(
     setup: &Setup,
     scene: &Scene,
     tail: &[State],
-) -> Result<(Vec<[f64; 2]>, Vec<[f64; 2]>), HarnessError> {
+) -> Result<(Positions, Positions), HarnessError> {
     let mut rollout = scene.clone();
     let mut preceding = Vec::with_capacity(tail.len());
     let mut adjacent = Vec::with_capacity(tail.len());

@@ -25,8 +25,8 @@ pub struct Fixture {
 }
 
 impl Fixture {
-    pub fn new() -> Fixture {
-        let text = include_str!("../../../configs/learn.toml");
+    pub fn load() -> Fixture {
+        let text = include_str!("../../../../configs/learn.toml");
         let mut config = LearnConfig::from_toml_str(text)
             .expect("the project's config")
             .with_user(UserConfig::preset(StylePreset::Aggressive));
