@@ -32,12 +32,25 @@ pub struct EvalConfig {
     pub users: Vec<UserKind>,
     /// Experience accumulation (Fig. 11).
     pub transfer: TransferConfig,
+    /// Closed-loop execution: grid cells run again with re-planning on; none if absent.
+    #[serde(default)]
+    pub closed_loop: ClosedLoopRuns,
     /// Compute time against horizon and step (Fig. 13).
     pub timing: TimingConfig,
     /// The qualitative example (Fig. 6).
     pub example: ExampleConfig,
     /// The `--quick` subset.
     pub quick: QuickConfig,
+}
+
+/// Closed-loop execution (`[closed_loop]`): every grid cell of these users run
+/// again, for every method, with the base config's `[planning.closed_loop]`
+/// turned on, against the same cell in open loop.
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClosedLoopRuns {
+    /// Names of the user kinds to run it for.
+    pub users: Vec<String>,
 }
 
 /// The grid of Section III: every combination is one run.
@@ -194,6 +207,9 @@ pub struct QuickConfig {
     pub users: Vec<String>,
     /// The quick timing experiment.
     pub timing: TimingConfig,
+    /// The quick closed-loop experiment (on the quick grid); none if absent.
+    #[serde(default)]
+    pub closed_loop: ClosedLoopRuns,
 }
 
 /// What one invocation runs: the full evaluation or the quick subset.
@@ -205,6 +221,8 @@ pub struct Selection {
     pub users: Vec<UserKind>,
     /// The transfer experiment.
     pub transfer: TransferConfig,
+    /// The closed-loop experiment.
+    pub closed_loop: ClosedLoopRuns,
     /// The timing experiment.
     pub timing: TimingConfig,
     /// The example.
@@ -242,6 +260,7 @@ impl EvalConfig {
                 grid: self.grid.resolve("grid", testbed)?,
                 users: self.users.clone(),
                 transfer: self.transfer.clone(),
+                closed_loop: self.closed_loop.clone(),
                 timing: self.timing.clone(),
                 example: self.example.clone(),
             });
@@ -260,6 +279,7 @@ impl EvalConfig {
             grid: self.quick.grid.resolve("quick.grid", testbed)?,
             users,
             transfer,
+            closed_loop: self.quick.closed_loop.clone(),
             timing: self.quick.timing.clone(),
             example: self.example.clone(),
         })
@@ -321,6 +341,18 @@ impl EvalConfig {
         }
         for name in &self.quick.users {
             self.user(name, "quick.users")?;
+        }
+        for name in &self.closed_loop.users {
+            self.user(name, "closed_loop.users")?;
+        }
+        for name in &self.quick.closed_loop.users {
+            if !self.quick.users.contains(name) {
+                return Err(EvalError::invalid(
+                    "quick.closed_loop.users",
+                    format_args!("`{name}`"),
+                    "a user kind of quick.users",
+                ));
+            }
         }
         if self.quick.users.is_empty() {
             return Err(EvalError::invalid(
@@ -483,6 +515,30 @@ mod tests {
         assert!(config.timing.dts.contains(&0.05));
         let quick = config.select(true, &testbed()).unwrap();
         assert!(quick.grid.cells() < full.grid.cells());
+    }
+
+    #[test]
+    fn closed_loop_users_are_known_and_the_quick_ones_run_in_the_quick_subset() {
+        let config = project_config();
+        assert_eq!(config.closed_loop.users, vec!["deterministic".to_owned()]);
+        let quick = config.select(true, &testbed()).unwrap();
+        assert_eq!(quick.closed_loop.users, vec!["deterministic".to_owned()]);
+        let mut bad = project_config();
+        bad.closed_loop.users = vec!["nobody".into()];
+        let error = bad.validate().unwrap_err().to_string();
+        assert!(error.contains("closed_loop.users"), "{error}");
+        let mut bad = project_config();
+        bad.quick.closed_loop.users = vec!["spread-2%".into()];
+        bad.quick.users = vec!["deterministic".into()];
+        let error = bad.validate().unwrap_err().to_string();
+        assert!(error.contains("quick.closed_loop.users"), "{error}");
+        // A config without the table runs no closed-loop run.
+        let without = PROJECT_CONFIG
+            .replace("[closed_loop]\nusers = [\"deterministic\"]\n", "")
+            .replace("[quick.closed_loop]\nusers = [\"deterministic\"]\n", "");
+        assert_ne!(without, PROJECT_CONFIG);
+        let config = EvalConfig::from_toml_str(&without).unwrap();
+        assert!(config.closed_loop.users.is_empty());
     }
 
     #[test]

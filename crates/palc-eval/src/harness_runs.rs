@@ -17,7 +17,7 @@ use palc_traffic::TestbedConfig;
 use serde::Serialize;
 
 use crate::EvalError;
-use crate::plan::RunSpec;
+use crate::plan::{Experiment, RunSpec};
 use crate::results::{Iteration, RunRow, Status};
 use crate::runner::Executor;
 
@@ -71,6 +71,9 @@ impl HarnessRuns {
         }
         if let Some(margin) = spec.horizon_margin_s {
             config.planning.horizon_margin_s = margin;
+        }
+        if spec.experiment == Experiment::ClosedLoop {
+            config.planning.closed_loop.enabled = true;
         }
         config.validate().map_err(|source| EvalError::Run {
             run: spec.label(),
@@ -185,6 +188,7 @@ impl Observer for RowRecorder {
             safety: record.safety,
             user_safety: record.user_safety,
             safety_refusal: record.safety_refusal,
+            closed_loop: record.closed_loop,
         });
     }
 

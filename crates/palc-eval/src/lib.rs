@@ -31,6 +31,7 @@
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod claims;
+pub mod closed_loop_report;
 pub mod config;
 mod error;
 #[cfg(feature = "plot")]

@@ -20,6 +20,8 @@ pub enum Experiment {
     Transfer,
     /// Compute time against step and horizon (Fig. 13).
     Timing,
+    /// A grid cell driven in closed loop (`[planning.closed_loop]` on).
+    ClosedLoop,
 }
 
 impl Experiment {
@@ -29,6 +31,7 @@ impl Experiment {
             Experiment::Grid => "grid",
             Experiment::Transfer => "transfer",
             Experiment::Timing => "timing",
+            Experiment::ClosedLoop => "closed-loop",
         }
     }
 }
@@ -99,7 +102,8 @@ impl RunSpec {
     }
 }
 
-/// The runs of a selection, in two phases: runs without experience first, then
+/// The runs of a selection, in two phases: runs without experience first (grid,
+/// timing, closed loop), then
 /// the transfer runs, which need the experience of phase-one runs.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunPlan {
@@ -179,6 +183,19 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
             }
         }
     }
+    let closed_loop: Vec<RunSpec> = (first.iter())
+        .filter(|s| {
+            s.experiment == Experiment::Grid && selection.closed_loop.users.contains(&s.user.name)
+        })
+        .cloned()
+        .collect();
+    for spec in closed_loop {
+        first.push(RunSpec {
+            id: first.len(),
+            experiment: Experiment::ClosedLoop,
+            ..spec
+        });
+    }
     let mut transfer = Vec::new();
     for target in first.iter().filter(|s| s.experiment == Experiment::Grid) {
         if !selection.transfer.users.contains(&target.user.name) {
@@ -235,7 +252,9 @@ fn transfer_source(selection: &Selection, target: &RunSpec, first: &[RunSpec]) -
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::config::{ExampleConfig, Grid, TimingConfig, TransferConfig, TransferSource};
+    use crate::config::{
+        ClosedLoopRuns, ExampleConfig, Grid, TimingConfig, TransferConfig, TransferSource,
+    };
 
     /// The paper's four speed cases (Section III.A).
     pub(crate) fn testbed() -> TestbedConfig {
@@ -284,6 +303,7 @@ pub(crate) mod tests {
                 source: TransferSource::NextSpeedCase,
                 users: vec!["deterministic".into()],
             },
+            closed_loop: ClosedLoopRuns::default(),
             timing: TimingConfig {
                 methods: vec![Method::Palc],
                 dts: vec![0.1, 0.05],
@@ -368,5 +388,23 @@ pub(crate) mod tests {
             error.contains("autobahn") && error.contains("timing.speed_case"),
             "{error}"
         );
+    }
+
+    #[test]
+    fn closed_loop_runs_repeat_the_grid_cells_of_their_users_in_phase_one() {
+        let mut selection = selection();
+        selection.closed_loop.users = vec!["deterministic".into()];
+        let plan = expand(&selection, &testbed()).unwrap();
+        let grid: Vec<&RunSpec> = (plan.first.iter())
+            .filter(|s| s.experiment == Experiment::Grid && s.user.name == "deterministic")
+            .collect();
+        let closed: Vec<&RunSpec> = (plan.first.iter())
+            .filter(|s| s.experiment == Experiment::ClosedLoop)
+            .collect();
+        assert_eq!(closed.len(), grid.len());
+        for (open, closed) in grid.iter().zip(&closed) {
+            assert_eq!(open.experiment_cell(), closed.experiment_cell());
+        }
+        assert!(plan.all().enumerate().all(|(i, s)| s.id == i));
     }
 }

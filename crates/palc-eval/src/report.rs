@@ -65,6 +65,7 @@ pub fn render(input: &ReportInput) -> String {
     crate::families_report::section(&mut out, input.rows, input.methods, input.user_kinds);
     claims_section(&mut out);
     crate::safety_report::section(&mut out, input.rows, input.methods);
+    crate::closed_loop_report::section(&mut out, input.rows, input.methods, input.users);
     refusals(&mut out, input.rows);
     learning_failures(&mut out, input);
     timing_section(&mut out, input);

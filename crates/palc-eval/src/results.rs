@@ -72,9 +72,12 @@ pub struct Iteration {
     /// Why the safety layer refused the learned plan, if it did.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub safety_refusal: Option<Violation>,
+    /// What the closed loop did (closed-loop runs only).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub closed_loop: Option<ClosedLoopStats>,
 }
 
-use palc_harness::{SafetyMetrics, Violation};
+use palc_harness::{ClosedLoopStats, SafetyMetrics, Violation};
 
 /// Names of the parts of [`Iteration::times_s`].
 pub const PART_NAMES: [&str; 5] = palc_harness::Timings::PART_NAMES;

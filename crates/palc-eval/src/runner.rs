@@ -195,6 +195,7 @@ pub(crate) mod tests {
                     safety: Default::default(),
                     user_safety: Default::default(),
                     safety_refusal: None,
+                    closed_loop: None,
                 })
                 .collect();
             let dt = spec.dt.unwrap_or(0.1);

@@ -32,7 +32,12 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
         out,
         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
     );
-    for experiment in [Experiment::Grid, Experiment::Transfer, Experiment::Timing] {
+    for experiment in [
+        Experiment::Grid,
+        Experiment::Transfer,
+        Experiment::Timing,
+        Experiment::ClosedLoop,
+    ] {
         for &method in methods {
             let iterations: Vec<&Iteration> = rows
                 .iter()

@@ -30,7 +30,7 @@ pub fn grid<'a>(rows: &'a [RunRow], method: Method, user: &str) -> Vec<&'a RunRo
 pub fn with_transfer<'a>(rows: &'a [RunRow], method: Method, user: &str) -> Vec<&'a RunRow> {
     rows.iter()
         .filter(|r| {
-            r.spec.experiment != Experiment::Timing
+            matches!(r.spec.experiment, Experiment::Grid | Experiment::Transfer)
                 && r.spec.method == method
                 && r.spec.user.name == user
         })
@@ -66,4 +66,27 @@ pub fn speed_label(row: &RunRow) -> String {
         "{} ({:.0}/{:.0} mph)",
         case.name, case.ego_mph, case.others_mph
     )
+}
+
+/// Pairs of the grid row and the closed-loop row of the same cell, for one
+/// method and user kind, in plan order.
+pub fn closed_loop_pairs<'a>(
+    rows: &'a [RunRow],
+    method: Method,
+    user: &str,
+) -> Vec<(&'a RunRow, &'a RunRow)> {
+    let open = grid(rows, method, user);
+    rows.iter()
+        .filter(|r| {
+            r.spec.experiment == Experiment::ClosedLoop
+                && r.spec.method == method
+                && r.spec.user.name == user
+        })
+        .filter_map(|closed| {
+            let cell = closed.spec.experiment_cell();
+            (open.iter())
+                .find(|o| o.spec.experiment_cell() == cell)
+                .map(|&o| (o, closed))
+        })
+        .collect()
 }

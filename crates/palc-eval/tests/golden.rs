@@ -58,6 +58,7 @@ fn subset(evaluation: &Evaluation) -> Selection {
         source: TransferSource::NextSpeedCase,
         users: selection.users.iter().map(|u| u.name.clone()).collect(),
     };
+    selection.closed_loop = Default::default();
     selection.timing = TimingConfig {
         dts: Vec::new(),
         ..selection.timing

@@ -13,6 +13,7 @@ use palc_aggregator::{
 use palc_planner::{LateralBoundsMode, Plan, Planner, PlannerConfig, Problem};
 
 use crate::HarnessError;
+use crate::closed_loop::ClosedLoop;
 use crate::config::{LearnConfig, StoppingConfig};
 use crate::drive::{Drive, execute, judge, plan_safety, problem};
 use crate::learn::{RunResult, aggregator_options, prepare_for};
@@ -58,6 +59,8 @@ pub struct LearningLoop {
     /// With the safety layer on, the standard ALC's plan and its predicted safety
     /// (checked safe): what the layer drives when it refuses `next_plan`.
     fallback: Option<(Plan, SafetyMetrics)>,
+    /// With `[planning.closed_loop]` on, the closed-loop driver.
+    closed_loop: Option<ClosedLoop>,
     /// Compute time of the step that produced `next_plan`.
     pending_times: Timings,
     records: Vec<LaneChangeRecord>,
@@ -158,6 +161,7 @@ impl LearningLoop {
             &scenes(&setup, None),
             &options,
         )?;
+        let closed_loop = ClosedLoop::for_config(config, &setup, planner.config())?;
         let started = Instant::now();
         let next_plan = planner.plan(&first_problem)?;
         let pending_times = Timings {
@@ -177,6 +181,7 @@ impl LearningLoop {
             experience,
             next_plan,
             fallback,
+            closed_loop,
             pending_times,
             records: Vec::new(),
             takeovers: 0,
@@ -201,6 +206,20 @@ impl LearningLoop {
     pub fn step(&mut self, observer: &mut dyn Observer) -> Result<&LaneChangeRecord, HarnessError> {
         let index = self.records.len();
         let (plan, planned_safety, refusal) = self.checked_plan()?;
+        let (plan, closed_loop) = match &self.closed_loop {
+            Some(driver) => {
+                let (plan, stats) = driver.drive(
+                    &self.setup,
+                    &self.experience,
+                    &self.options,
+                    &plan,
+                    refusal.is_some(),
+                )?;
+                (plan, Some(stats))
+            }
+            None => (plan, None),
+        };
+        let refusal = refusal.or(closed_loop.and_then(|c| c.first_refusal));
         if let Some(violation) = &refusal {
             observer.safety_refusal(index, violation);
         }
@@ -208,6 +227,7 @@ impl LearningLoop {
         let mut record = self.record(&drive, nominal_plan_taken_over);
         record.planned_safety = planned_safety;
         record.safety_refusal = refusal;
+        record.closed_loop = closed_loop;
         observer.lane_change(&record);
         self.records.push(record);
         self.pending_times = Timings::default();
@@ -344,6 +364,7 @@ impl LearningLoop {
             user_safety: drive.user_safety,
             planned_safety: SafetyMetrics::default(),
             safety_refusal: None,
+            closed_loop: None,
             learning_error: None,
         }
     }
@@ -540,6 +561,7 @@ mod tests {
             user_safety: SafetyMetrics::default(),
             planned_safety: SafetyMetrics::default(),
             safety_refusal: None,
+            closed_loop: None,
             learning_error: None,
         }
     }

@@ -31,6 +31,7 @@
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 mod acc;
+pub mod closed_loop;
 mod config;
 mod drive;
 mod error;
@@ -46,6 +47,7 @@ mod standard_alc;
 pub mod user;
 
 pub use acc::AccConfig;
+pub use closed_loop::{ClosedLoopConfig, ClosedLoopStats};
 pub use config::{
     CellChoice, LearnConfig, MAX_LANE_CHANGES, MAX_SUCCESS_STREAK, MAX_TAKEOVERS, StoppingConfig,
     UserConfig, UserStyle,

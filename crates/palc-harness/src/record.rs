@@ -3,6 +3,7 @@
 use palc_aggregator::Timings;
 use serde::{Deserialize, Serialize};
 
+use crate::closed_loop::ClosedLoopStats;
 use crate::safety::{SafetyMetrics, Violation};
 use crate::user::TakeoverCause;
 
@@ -61,8 +62,14 @@ pub struct LaneChangeRecord {
     /// Safety of the driven plan as the safety layer predicted it, driven to its end.
     pub planned_safety: SafetyMetrics,
     /// Why the safety layer refused the learned plan, if it did; the standard ALC's
-    /// plan was driven instead.
+    /// plan was driven instead. In closed loop, the first refusal of the lane
+    /// change, at its start or at a re-plan.
     pub safety_refusal: Option<Violation>,
+    /// What the closed loop did (`[planning.closed_loop]`); `None` in open loop.
+    /// The planned lateral positions are then those the system drove, re-plans
+    /// included.
+    #[serde(default)]
+    pub closed_loop: Option<ClosedLoopStats>,
     /// Why the learning step after this lane change failed, if it did, as a
     /// message for `--record` files; the experience then stays as it was.
     /// Observers see the typed error in [`crate::LessonEvent::Failed`].

@@ -14,6 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::HarnessError;
 use crate::acc::{AccConfig, acc_leader};
+use crate::closed_loop::ClosedLoopConfig;
 use crate::safety::SafetyConfig;
 use crate::user::{ExpectedLaneChange, Situation, Style, StylePreset};
 
@@ -50,6 +51,8 @@ pub struct PlanningConfig {
     pub acc: AccConfig,
     /// The safe distance of the safety layer and of the safety measures.
     pub safety: SafetyConfig,
+    /// Closed-loop execution: re-planning while the lane change is driven.
+    pub closed_loop: ClosedLoopConfig,
 }
 
 impl Default for PlanningConfig {
@@ -71,6 +74,7 @@ impl Default for PlanningConfig {
             takeover_threshold_m: 0.3,
             acc: AccConfig::default(),
             safety: SafetyConfig::default(),
+            closed_loop: ClosedLoopConfig::default(),
         }
     }
 }
@@ -115,7 +119,8 @@ impl PlanningConfig {
         }
         self.standard_alc.validate("planning.standard_alc")?;
         self.acc.validate("planning.acc")?;
-        self.safety.validate("planning.safety")
+        self.safety.validate("planning.safety")?;
+        self.closed_loop.validate("planning.closed_loop", self.dt)
     }
 }
 

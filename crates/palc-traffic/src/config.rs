@@ -197,6 +197,10 @@ pub struct TestbedConfig {
     /// of following the IDM. None (the paper's test bed) if absent.
     #[serde(default)]
     pub preceding_braking: Option<PrecedingBrakingConfig>,
+    /// A stress scene: the target lane's lag vehicle accelerates into the gap when
+    /// the ego starts its lane change. None (the paper's test bed) if absent.
+    #[serde(default)]
+    pub lag_accelerating: Option<crate::lag::LagAcceleratingConfig>,
 }
 
 /// `[testbed.preceding_braking]`: the preceding vehicle holds the background speed,
@@ -317,6 +321,9 @@ impl ScenarioConfig {
                 idm.desired_speed_ratio,
                 "above 1",
             ));
+        }
+        if let Some(lag) = self.testbed.as_ref().and_then(|t| t.lag_accelerating) {
+            lag.validate(self.road.lane_width_m)?;
         }
         match (&self.testbed, &self.platoon) {
             (None, None) => Err(ConfigError::ScenarioKind { found: "neither" }),

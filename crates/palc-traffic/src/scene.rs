@@ -26,6 +26,8 @@ pub struct Scene {
     pub(crate) ego: Option<usize>,
     pub(crate) preceding: Option<usize>,
     pub(crate) adjacent: Option<usize>,
+    /// The accelerating lag vehicle of a stress scene, if armed.
+    pub(crate) lag_push: Option<crate::lag::LagPush>,
 }
 
 impl Scene {
@@ -82,6 +84,7 @@ impl Scene {
             ego,
             preceding: None,
             adjacent: None,
+            lag_push: None,
         };
         scene.check_no_overlap()?;
         Ok(scene)
@@ -120,6 +123,35 @@ impl Scene {
     /// The target-lane vehicle the ego follows after its lane change (fixed at construction).
     pub fn adjacent(&self) -> Option<&Vehicle> {
         self.adjacent.map(|i| &self.vehicles[i])
+    }
+
+    /// This scene with its preceding and adjacent vehicles named by hand (a scene
+    /// built with [`Scene::new`] has neither; the test bed sets both).
+    ///
+    /// # Errors
+    /// [`ConfigError::OutOfRange`] naming `preceding` or `adjacent` when no vehicle
+    /// of the scene has that identifier, or when it is the ego.
+    pub fn with_roles(
+        mut self,
+        preceding: VehicleId,
+        adjacent: VehicleId,
+    ) -> Result<Scene, ConfigError> {
+        let find = |field: &str, id: VehicleId| {
+            self.vehicles
+                .iter()
+                .position(|v| v.id == id && !matches!(v.driver, Driver::External { .. }))
+                .ok_or_else(|| {
+                    crate::config::out_of_range(
+                        field,
+                        f64::from(id.0),
+                        "a background vehicle of the scene",
+                    )
+                })
+        };
+        let (p, a) = (find("preceding", preceding)?, find("adjacent", adjacent)?);
+        self.preceding = Some(p);
+        self.adjacent = Some(a);
+        Ok(self)
     }
 
     /// Whether vehicle `index` occupies `lane`: background vehicles occupy their own lane; the
@@ -245,6 +277,7 @@ impl Scene {
 
     /// One synchronous update; `ego_next` replaces the ego's stand-in when given.
     pub(crate) fn advance(&mut self, dt: f64, ego_next: Option<EgoState>) {
+        self.trigger_lag_push();
         let accelerations: Vec<f64> = (0..self.vehicles.len())
             .map(|i| self.model_acceleration(i))
             .collect();

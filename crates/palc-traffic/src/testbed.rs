@@ -389,7 +389,10 @@ pub(crate) fn build(config: &ScenarioConfig, cell: &TestbedCell) -> Result<Scene
     let mut scene = Scene::new(road, vehicles, idm.max_braking_mps2)?;
     scene.preceding = Some(1);
     scene.adjacent = Some(adjacent);
-    Ok(scene)
+    match testbed.lag_accelerating {
+        Some(lag) => scene.with_lag_accelerating(lag),
+        None => Ok(scene),
+    }
 }
 
 impl Scene {

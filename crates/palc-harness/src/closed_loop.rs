@@ -1,0 +1,469 @@
+//! Closed-loop execution of a lane change (`[planning.closed_loop]`, off by
+//! default): the ego drives the first `N` steps of a plan, then plans again from
+//! the state it has reached, with fresh predictions of the other vehicles and the
+//! same learned weights and zone, and so on to the end of the horizon.
+//!
+//! **Shrinking horizon.** A re-plan at step `e` covers the remaining `K − e`
+//! steps and keeps the terminal conditions of the one-shot plan (lateral position,
+//! speed and, under the ACC, station at step `K`). The weights are time-indexed
+//! (column `i − 1` weighs stage `i`, which is how the planner decides *when* to
+//! move), so a re-plan at step `e` takes columns `e..K` of the experience's
+//! weights: every stage keeps the weight it had in the one-shot plan. A receding
+//! horizon of fixed length would need weights and terminal conditions beyond step
+//! `K`, which nothing has learned, and would push the end of the lane change
+//! further out at every re-plan. With exact predictions the shrinking horizon
+//! gives back the one-shot plan (the cost is a sum of stage costs, so the tail of
+//! an optimal plan is optimal for the tail problem).
+//!
+//! **Predictions.** As [`crate::Setup::new`] does, by rolling out a copy of the
+//! current scene with every background vehicle on its own model; the ego in that
+//! rollout follows the plan it is executing (in `Setup::new` it keeps its lane,
+//! as no plan exists yet).
+//!
+//! **Safety layer.** With `planning.safety.enforce`, every re-plan is driven to its
+//! end in a copy of the current scene before the ego drives it; a plan with a
+//! safe-distance violation is refused (a recorded [`Violation`]) and the lane
+//! change falls back to the standard ALC's weights, without the zone, re-planned
+//! from the same state; if that plan is unsafe as well, the ego keeps the plan it
+//! is driving (checked when it was made). A re-plan the planner cannot solve also
+//! keeps the current plan, and is counted.
+//!
+//! The result is one trajectory over steps `0..=K`, what the system drives when
+//! nobody takes over; [`crate::advanced::execute`] then drives it with the user,
+//! who takes over at the first driven step that deviates from the expected one,
+//! exactly as in open loop, so that lessons are labelled the same way.
+
+use palc_aggregator::{AggregatorOptions, Experience, plan_problem};
+use palc_planner::{Plan, Planner, PlannerConfig, Position, State, Weights, features};
+use palc_traffic::{EgoState, Scene};
+use palc_zone_filter::StepScene;
+use serde::{Deserialize, Serialize};
+
+use crate::HarnessError;
+use crate::config::LearnConfig;
+use crate::drive::problem;
+use crate::safety::{SafetyMetrics, SafetyMonitor, Violation};
+use crate::setup::Setup;
+
+/// Closed-loop execution (`[planning.closed_loop]`); defaults in `configs/learn.toml`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ClosedLoopConfig {
+    /// Whether the lane change is re-planned while it is driven. Off by default:
+    /// the paper's figures use one plan per lane change.
+    pub enabled: bool,
+    /// Time between re-plans (s): a multiple of `planning.dt`, at most the
+    /// horizon. 0.1 s is 10 Hz.
+    pub replan_period_s: f64,
+}
+
+impl Default for ClosedLoopConfig {
+    fn default() -> Self {
+        Self {
+            enabled: false,
+            replan_period_s: 0.1,
+        }
+    }
+}
+
+impl ClosedLoopConfig {
+    /// Checks the period: finite and `> 0`, and, when closed loop is enabled, a
+    /// whole number of steps of `dt` (a disabled table does not hold back a run at
+    /// another step, e.g. the timing experiment's 0.2 s). `table` is the dotted
+    /// path of the table (`planning.closed_loop`).
+    ///
+    /// # Errors
+    /// [`HarnessError::InvalidConfig`] naming `{table}.replan_period_s`.
+    pub fn validate(&self, table: &str, dt: f64) -> Result<(), HarnessError> {
+        let field = format!("{table}.replan_period_s");
+        let period = self.replan_period_s;
+        if !(period.is_finite() && period > 0.0) {
+            return Err(HarnessError::InvalidConfig {
+                field,
+                value: period,
+                bound: "a finite value > 0".to_owned(),
+            });
+        }
+        if !self.enabled {
+            return Ok(());
+        }
+        let steps = period / dt;
+        if !(steps.is_finite() && steps >= 0.5 && (steps - steps.round()).abs() <= 1e-6) {
+            return Err(HarnessError::InvalidConfig {
+                field,
+                value: period,
+                bound: format!("a whole multiple of planning.dt = {dt:?} s"),
+            });
+        }
+        Ok(())
+    }
+
+    /// The period in steps of `dt` (valid after [`ClosedLoopConfig::validate`]).
+    pub fn period_steps(&self, dt: f64) -> usize {
+        ((self.replan_period_s / dt).round() as usize).max(1)
+    }
+
+    /// Checks the period against the horizon of a scenario (`K` steps of `dt`).
+    ///
+    /// # Errors
+    /// [`HarnessError::InvalidConfig`] naming `{table}.replan_period_s` when the
+    /// period is longer than the horizon.
+    pub fn check_horizon(&self, table: &str, dt: f64, horizon: usize) -> Result<(), HarnessError> {
+        if self.period_steps(dt) > horizon {
+            return Err(HarnessError::InvalidConfig {
+                field: format!("{table}.replan_period_s"),
+                value: self.replan_period_s,
+                bound: format!(
+                    "at most the horizon, {horizon} steps of {dt:?} s ({:?} s)",
+                    horizon as f64 * dt
+                ),
+            });
+        }
+        Ok(())
+    }
+}
+
+/// What the closed loop did in one lane change (recorded as
+/// [`crate::LaneChangeRecord::closed_loop`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct ClosedLoopStats {
+    /// Re-plans solved and checked (refused ones included).
+    pub replans: usize,
+    /// Re-plans the planner could not solve; the ego kept its current plan.
+    pub replan_failures: usize,
+    /// Re-plans the safety layer refused.
+    pub refusals: usize,
+    /// Step from which the standard ALC's weights drove the lane change, if the
+    /// safety layer fell back to them (0 when the first plan was refused).
+    pub fallback_step: Option<usize>,
+    /// The first refusal.
+    pub first_refusal: Option<Violation>,
+}
+
+/// Which weights a re-plan uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Policy {
+    /// The experience's weights and zone.
+    Learned,
+    /// The standard ALC's weights, without the zone (the safety layer's fallback).
+    Standard,
+}
+
+/// The closed-loop driver of one scenario: the scenario, the planner's settings,
+/// the period and, with the safety layer, the standard ALC's weights.
+#[derive(Debug, Clone)]
+pub struct ClosedLoop {
+    planner: PlannerConfig,
+    period: usize,
+    /// The standard ALC's weights at the scenario's horizon, when the safety layer
+    /// is on (the fallback).
+    standard: Option<Weights>,
+}
+
+/// One re-plan's result: the plan, or why the ego keeps the current one.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Replan {
+    /// A plan the ego can drive (checked safe, or not checked).
+    Drive(Plan),
+    /// The safety layer refused the plan.
+    Refused(Violation),
+    /// The planner failed.
+    Failed,
+}
+
+impl ClosedLoop {
+    /// A closed-loop driver re-planning every `period` steps with `planner`'s
+    /// settings (its horizon is set per re-plan); `standard` is the standard ALC's
+    /// weights at the scenario's horizon when the safety layer is on.
+    ///
+    /// # Errors
+    /// [`HarnessError::InvalidConfig`] for a period of 0 steps.
+    pub fn new(
+        planner: PlannerConfig,
+        period: usize,
+        standard: Option<Weights>,
+    ) -> Result<Self, HarnessError> {
+        if period == 0 {
+            return Err(HarnessError::InvalidConfig {
+                field: "planning.closed_loop.replan_period_s".to_owned(),
+                value: 0.0,
+                bound: "at least one step".to_owned(),
+            });
+        }
+        Ok(Self {
+            planner,
+            period,
+            standard,
+        })
+    }
+
+    /// The closed-loop driver of `config` in the scenario of `setup`, planning with
+    /// `planner`'s settings; `None` when `planning.closed_loop.enabled` is off.
+    ///
+    /// # Errors
+    /// [`HarnessError::InvalidConfig`] naming `planning.closed_loop.replan_period_s`
+    /// for a period longer than the horizon.
+    pub(crate) fn for_config(
+        config: &LearnConfig,
+        setup: &Setup,
+        planner: &PlannerConfig,
+    ) -> Result<Option<Self>, HarnessError> {
+        let closed = config.planning.closed_loop;
+        if !closed.enabled {
+            return Ok(None);
+        }
+        closed.validate("planning.closed_loop", setup.dt)?;
+        closed.check_horizon("planning.closed_loop", setup.dt, setup.horizon)?;
+        let standard = config.planning.safety.enforce.then(|| {
+            let lane_change = setup.standard_lane_change(&config.planning.standard_alc);
+            (config.standard_weights).weights(&lane_change, setup.horizon, setup.dt)
+        });
+        Self::new(planner.clone(), closed.period_steps(setup.dt), standard).map(Some)
+    }
+
+    /// Drives a lane change in closed loop from `first` (the plan the safety layer
+    /// let through, or its fallback when `fell_back`), re-planning with
+    /// `experience` (weights at the scenario's horizon) and `options`. Returns the
+    /// trajectory the system drives over steps `0..=K` and what the loop did.
+    ///
+    /// # Errors
+    /// Scene errors while driving, and aggregator errors that no re-plan can
+    /// recover from (invalid options or experience).
+    pub fn drive(
+        &self,
+        setup: &Setup,
+        experience: &Experience,
+        options: &AggregatorOptions,
+        first: &Plan,
+        fell_back: bool,
+    ) -> Result<(Plan, ClosedLoopStats), HarnessError> {
+        let k = setup.horizon;
+        let mut stats = ClosedLoopStats {
+            fallback_step: fell_back.then_some(0),
+            ..ClosedLoopStats::default()
+        };
+        let mut policy = if fell_back && self.standard.is_some() {
+            Policy::Standard
+        } else {
+            Policy::Learned
+        };
+        let mut scene = setup.scene.clone();
+        let mut current = first.clone();
+        // The step of the trajectory at which `current` starts.
+        let mut start = 0;
+        let mut states = vec![first.states[0]];
+        let mut controls = Vec::with_capacity(k);
+        let mut lateral_violation = vec![first.lateral_violation.first().copied().unwrap_or(0.0)];
+        let mut step = 0;
+        while step < k {
+            let until = (step + self.period).min(k);
+            for i in step..until {
+                let j = i - start;
+                let next = current.states[j + 1];
+                controls.push(current.controls[j]);
+                states.push(next);
+                lateral_violation
+                    .push(current.lateral_violation.get(j + 1).copied().unwrap_or(0.0));
+                scene.step(setup.dt, ego_state(setup, &next))?;
+            }
+            step = until;
+            // Re-plan while at least two steps remain.
+            if k - step < 2 {
+                continue;
+            }
+            let tail = &current.states[step - start..];
+            let mut outcome =
+                self.replan(setup, experience, options, &scene, tail, step, policy)?;
+            stats.replans += 1;
+            if let Replan::Refused(violation) = outcome {
+                stats.refusals += 1;
+                stats.first_refusal.get_or_insert(violation);
+                if policy == Policy::Learned && self.standard.is_some() {
+                    policy = Policy::Standard;
+                    stats.fallback_step = Some(step);
+                    outcome =
+                        self.replan(setup, experience, options, &scene, tail, step, policy)?;
+                    stats.replans += 1;
+                    if let Replan::Refused(_) = outcome {
+                        stats.refusals += 1;
+                    }
+                }
+            }
+            match outcome {
+                Replan::Drive(plan) => {
+                    current = plan;
+                    start = step;
+                }
+                Replan::Failed => stats.replan_failures += 1,
+                Replan::Refused(_) => {}
+            }
+        }
+        let full = problem(setup, experience.weights.clone(), Vec::new());
+        let features = features(&states, &controls, &full.preceding, &full.adjacent)?;
+        let learned_cost = experience.weights.dot(&features).unwrap_or(f64::NAN);
+        let plan = Plan {
+            states,
+            controls,
+            objective: learned_cost,
+            learned_cost,
+            extras: palc_planner::Extras::default(),
+            features,
+            lateral_violation,
+            stats: first.stats,
+        };
+        Ok((plan, stats))
+    }
+
+    /// One re-plan at step `step` of the lane change from `scene`, the scene
+    /// reached there; `tail` is the rest of the plan the ego is driving (its first
+    /// state is the current one, `K − step + 1` states). The plan covers the
+    /// remaining `K − step` steps with the columns `step..K` of the policy's
+    /// weights; with the safety layer on it is driven to its end in a copy of
+    /// `scene` and refused on a violation.
+    ///
+    /// # Errors
+    /// [`HarnessError::InvalidConfig`] for a `step` outside `1..K` or a `tail` of
+    /// another length; scene errors of the rollouts.
+    #[allow(clippy::too_many_arguments)]
+    pub fn replan(
+        &self,
+        setup: &Setup,
+        experience: &Experience,
+        options: &AggregatorOptions,
+        scene: &Scene,
+        tail: &[State],
+        step: usize,
+        policy: Policy,
+    ) -> Result<Replan, HarnessError> {
+        let k = setup.horizon;
+        if step == 0 || step >= k || tail.len() != k - step + 1 {
+            return Err(HarnessError::InvalidConfig {
+                field: "closed_loop.replan.step".to_owned(),
+                value: step as f64,
+                bound: format!(
+                    "a step in 1..{k} with the {} remaining states of the plan",
+                    k.saturating_sub(step) + 1
+                ),
+            });
+        }
+        let remaining = k - step;
+        let (preceding, adjacent) = predict(setup, scene, tail)?;
+        let mut template = problem(setup, experience.weights.clone(), Vec::new());
+        template.initial = tail[0];
+        template.reference_speed.drain(..step);
+        template.preceding = (preceding[..remaining].iter())
+            .map(|p| Position { s: p[0], l: p[1] })
+            .collect();
+        template.adjacent = (adjacent[..remaining].iter())
+            .map(|p| Position { s: p[0], l: p[1] })
+            .collect();
+        template.lateral_bounds = vec![None; remaining + 1];
+        let shifted = |weights: &Weights| {
+            Weights::from_columns(weights.columns()[step.min(weights.horizon())..].to_vec())
+        };
+        let policy_experience = match (policy, &self.standard) {
+            (Policy::Standard, Some(standard)) => Experience {
+                weights: shifted(standard),
+                zone: None,
+                ..experience.clone()
+            },
+            _ => Experience {
+                weights: shifted(&experience.weights),
+                ..experience.clone()
+            },
+        };
+        template.weights = policy_experience.weights.clone();
+        // The zone's view of each remaining step: the current plan's position and
+        // speed, the fresh predictions.
+        let step_scenes: Vec<StepScene> = (0..=remaining)
+            .map(|i| {
+                let state = tail.get(i).copied().unwrap_or(tail[tail.len() - 1]);
+                StepScene {
+                    ego_s: state.s,
+                    reference_l: state.l,
+                    ego_speed: state.v.max(setup.lane_keeping[step + i][1] * 1e-3),
+                    preceding: preceding[i],
+                    adjacent: adjacent[i],
+                }
+            })
+            .collect();
+        let mut planner = Planner::new(PlannerConfig {
+            horizon: remaining,
+            ..self.planner.clone()
+        })?;
+        let Ok((problem, _)) = plan_problem(
+            &planner,
+            &policy_experience,
+            &template,
+            &step_scenes,
+            options,
+        ) else {
+            return Ok(Replan::Failed);
+        };
+        let Ok(plan) = planner.plan(&problem) else {
+            return Ok(Replan::Failed);
+        };
+        if self.standard.is_some() {
+            let safety = safety_from(setup, scene, &plan.states, step)?;
+            if let Some(violation) = safety.first_violation {
+                return Ok(Replan::Refused(violation));
+            }
+        }
+        Ok(Replan::Drive(plan))
+    }
+}
+
+/// `(s − origin_s, l)` of a vehicle per step.
+type Positions = Vec<[f64; 2]>;
+
+/// Predicted preceding and adjacent vehicles `(s − origin_s, l)` at the steps of
+/// `tail`, from a copy of `scene` in which the ego drives `tail`.
+fn predict(
+    setup: &Setup,
+    scene: &Scene,
+    tail: &[State],
+) -> Result<(Positions, Positions), HarnessError> {
+    let mut rollout = scene.clone();
+    let mut preceding = Vec::with_capacity(tail.len());
+    let mut adjacent = Vec::with_capacity(tail.len());
+    let frame = |v: Option<&palc_traffic::Vehicle>| {
+        v.map_or([1e4, 0.0], |v| [v.state.s - setup.origin_s, v.state.l])
+    };
+    for (i, state) in tail.iter().enumerate() {
+        if i > 0 {
+            rollout.step(setup.dt, ego_state(setup, state))?;
+        }
+        preceding.push(frame(rollout.preceding()));
+        adjacent.push(frame(rollout.adjacent()));
+    }
+    Ok((preceding, adjacent))
+}
+
+/// The safety of `states` driven from `scene` (reached at `step` of the lane
+/// change) to their end, in a copy of it; steps are those of the lane change.
+fn safety_from(
+    setup: &Setup,
+    scene: &Scene,
+    states: &[State],
+    step: usize,
+) -> Result<SafetyMetrics, HarnessError> {
+    let mut rollout = scene.clone();
+    // The monitor of the whole lane change: its start lane and preceding vehicle
+    // are those at the trigger.
+    let mut monitor = SafetyMonitor::new(setup.safety, &setup.scene, setup.target_l);
+    monitor.observe(step, &rollout);
+    for (i, state) in states.iter().enumerate().skip(1) {
+        rollout.step(setup.dt, ego_state(setup, state))?;
+        monitor.observe(step + i, &rollout);
+    }
+    Ok(monitor.metrics())
+}
+
+fn ego_state(setup: &Setup, state: &State) -> EgoState {
+    EgoState {
+        s: state.s + setup.origin_s,
+        l: state.l,
+        v: state.v.max(0.0),
+        heading: state.phi,
+    }
+}

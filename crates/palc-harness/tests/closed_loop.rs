@@ -1,0 +1,205 @@
+//! Closed-loop execution (`[planning.closed_loop]`): with exact predictions it
+//! drives the one-shot plan, so the user takes over where they would in open
+//! loop; its config is checked naming the field; its record round-trips.
+
+use palc_aggregator::{AggregatorOptions, Experience, plan_problem};
+use palc_harness::advanced::{execute, problem};
+use palc_harness::closed_loop::ClosedLoop;
+use palc_harness::{
+    ClosedLoopStats, LearnConfig, PlanningConfig, Setup, StandardWeights, StylePreset, Violation,
+};
+use palc_planner::{Planner, PlannerConfig};
+use palc_traffic::{
+    Driver, IdmParams, Lane, Road, Scene, SpeedProfile, Vehicle, VehicleId, VehicleState,
+};
+
+fn vehicle(id: u32, lane: Lane, s: f64, v: f64, driver: Driver) -> Vehicle {
+    Vehicle {
+        id: VehicleId(id),
+        length: 5.0,
+        width: 1.8,
+        lane,
+        state: VehicleState {
+            s,
+            l: Road::paper().lane_centre(lane),
+            v,
+            a: 0.0,
+            heading: 0.0,
+        },
+        driver,
+    }
+}
+
+/// A scene in which nothing reacts to the ego: a slower preceding vehicle and a
+/// target-lane vehicle far ahead, both at scripted constant speeds, so that every
+/// prediction is exact.
+fn scripted_scene() -> Scene {
+    let constant = |v: f64| Driver::Scripted(SpeedProfile::new(vec![(0.0, v)]).unwrap());
+    let ego = vehicle(
+        0,
+        Lane(0),
+        20.0,
+        20.0,
+        Driver::External {
+            stand_in: IdmParams::treiber_2000(20.0),
+        },
+    );
+    Scene::new(
+        Road::paper(),
+        vec![
+            ego,
+            vehicle(1, Lane(0), 80.0, 15.0, constant(15.0)),
+            vehicle(2, Lane(1), 150.0, 20.0, constant(20.0)),
+        ],
+        9.0,
+    )
+    .unwrap()
+    .with_roles(VehicleId(1), VehicleId(2))
+    .unwrap()
+}
+
+#[test]
+fn with_exact_predictions_the_closed_loop_sees_the_open_loop_takeover() {
+    let planning = PlanningConfig::default();
+    let setup = Setup::new(&scripted_scene(), &planning, "scripted").unwrap();
+    let (k, dt) = (setup.horizon, setup.dt);
+    let standard = setup.standard_lane_change(&planning.standard_alc);
+    let weights = StandardWeights::default().weights(&standard, k, dt);
+    let experience = Experience::new("aggressive", "scripted", "palc", weights, dt).unwrap();
+    let options = AggregatorOptions::default();
+    let mut planner = Planner::new(PlannerConfig {
+        horizon: k,
+        dt,
+        ..PlannerConfig::default()
+    })
+    .unwrap();
+    let template = problem(&setup, experience.weights.clone(), Vec::new());
+    let (first, _) = plan_problem(&planner, &experience, &template, &[], &options).unwrap();
+    let plan = planner.plan(&first).unwrap();
+    let expected = setup.expected(&StylePreset::Aggressive.style()).unwrap();
+
+    let open = execute(&setup, plan.clone(), expected, 0.3).unwrap();
+    let driver = ClosedLoop::new(planner.config().clone(), 1, None).unwrap();
+    let (driven, stats) = driver
+        .drive(&setup, &experience, &options, &plan, false)
+        .unwrap();
+    assert_eq!(stats.replans, k - 2, "{stats:?}");
+    assert_eq!(stats.replan_failures, 0);
+    let closed = execute(&setup, driven, expected, 0.3).unwrap();
+
+    let open_takeover = open
+        .takeover
+        .expect("the aggressive user takes over the standard plan");
+    let closed_takeover = closed.takeover.expect("and the closed loop's");
+    assert_eq!(open_takeover.step, closed_takeover.step);
+    assert!((open_takeover.deviation_m - closed_takeover.deviation_m).abs() < 1e-3);
+    // What the system drove is the one-shot plan, to the solver's tolerance.
+    for (a, b) in open.plan.states.iter().zip(&closed.plan.states) {
+        assert!((a.l - b.l).abs() < 1e-3, "{} vs {}", a.l, b.l);
+        assert!((a.s - b.s).abs() < 1e-2, "{} vs {}", a.s, b.s);
+    }
+}
+
+#[test]
+fn the_replan_period_is_checked_naming_the_field() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../configs/learn.toml"
+    ))
+    .unwrap();
+    let base = LearnConfig::from_toml_str(&text).unwrap();
+    assert!(!base.planning.closed_loop.enabled);
+    // Disabled, the period need not be a multiple of the step (the timing
+    // experiment runs at 0.2 s), but it must still be a period.
+    let with = text.replace("replan_period_s = 0.1 ", "replan_period_s = 0.15 ");
+    LearnConfig::from_toml_str(&with).unwrap();
+    let with = text.replace("replan_period_s = 0.1 ", "replan_period_s = -1.0 ");
+    let err = LearnConfig::from_toml_str(&with).unwrap_err().to_string();
+    assert!(
+        err.contains("planning.closed_loop.replan_period_s"),
+        "{err}"
+    );
+    let text = text.replace(
+        "enabled = false                    # off: one plan",
+        "enabled = true # one plan",
+    );
+    for (period, bound) in [
+        ("0.0", "> 0"),
+        ("-0.1", "> 0"),
+        ("0.15", "multiple of planning.dt"),
+        ("0.05", "multiple of planning.dt"),
+    ] {
+        let with = text.replace(
+            "replan_period_s = 0.1 ",
+            &format!("replan_period_s = {period} "),
+        );
+        let err = LearnConfig::from_toml_str(&with).unwrap_err().to_string();
+        assert!(
+            err.contains("planning.closed_loop.replan_period_s") && err.contains(bound),
+            "{period}: {err}"
+        );
+    }
+    let with = text.replace("replan_period_s = 0.1 ", "replan_period_s = 0.3 ");
+    LearnConfig::from_toml_str(&with).unwrap();
+    // Longer than the horizon: refused when the scenario is prepared.
+    let with = text
+        .replace(
+            "enabled = false                    # off: one plan",
+            "enabled = true # one plan",
+        )
+        .replace("replan_period_s = 0.1 ", "replan_period_s = 50.0 ");
+    let config = LearnConfig::from_toml_str(&with).unwrap();
+    assert!(config.planning.closed_loop.enabled);
+    let err = palc_harness::LearningLoop::new(&config, None)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("planning.closed_loop.replan_period_s") && err.contains("at most the horizon"),
+        "{err}"
+    );
+}
+
+#[test]
+fn closed_loop_stats_round_trip_through_json() {
+    let stats = ClosedLoopStats {
+        replans: 41,
+        replan_failures: 1,
+        refusals: 2,
+        fallback_step: Some(12),
+        first_refusal: Some(Violation {
+            step: 12,
+            role: palc_harness::safety::Role::TargetLag,
+            vehicle: 4,
+            gap_m: 6.1,
+            safe_distance_m: 14.2,
+        }),
+    };
+    let text = serde_json::to_string(&stats).unwrap();
+    let back: ClosedLoopStats = serde_json::from_str(&text).unwrap();
+    assert_eq!(back, stats);
+}
+
+#[test]
+fn a_closed_loop_run_records_its_replans_and_round_trips() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../configs/learn.toml"
+    ))
+    .unwrap();
+    let mut config = LearnConfig::from_toml_str(&text).unwrap();
+    config.planning.closed_loop.enabled = true;
+    config.planning.closed_loop.replan_period_s = 0.5;
+    config.stopping.max_takeovers = 2;
+    let mut run = palc_harness::LearningLoop::new(&config, None).unwrap();
+    let record = run.step(&mut palc_harness::NoObserver).unwrap().clone();
+    let stats = record.closed_loop.expect("a closed-loop record");
+    assert!(stats.replans > 0, "{stats:?}");
+    let text = serde_json::to_string(&record).unwrap();
+    let back: palc_harness::LaneChangeRecord = serde_json::from_str(&text).unwrap();
+    assert_eq!(back, record);
+    // An open-loop record written before the field existed still reads.
+    let mut value: serde_json::Value = serde_json::from_str(&text).unwrap();
+    value.as_object_mut().unwrap().remove("closed_loop");
+    let old: palc_harness::LaneChangeRecord = serde_json::from_value(value).unwrap();
+    assert_eq!(old.closed_loop, None);
+}
