@@ -321,12 +321,12 @@ impl EvalConfig {
             if let Some(family) = &user.family {
                 family
                     .validate(&format!("users[{i}].family"))
-                    .map_err(|source| EvalError::invalid_user(source))?;
+                    .map_err(EvalError::invalid_user)?;
             }
             if let Some(parameters) = &user.spread_parameters {
                 parameters
                     .validate(&format!("users[{i}].spread_parameters"))
-                    .map_err(|source| EvalError::invalid_user(source))?;
+                    .map_err(EvalError::invalid_user)?;
             }
             if self.users[..i].iter().any(|u| u.name == user.name) {
                 return Err(EvalError::invalid(

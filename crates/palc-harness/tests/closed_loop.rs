@@ -5,6 +5,7 @@
 use palc_aggregator::{AggregatorOptions, Experience, plan_problem};
 use palc_harness::advanced::{execute, problem};
 use palc_harness::closed_loop::ClosedLoop;
+use palc_harness::user::{SimulatedUser, User};
 use palc_harness::{
     ClosedLoopStats, LearnConfig, PlanningConfig, Setup, StandardWeights, StylePreset, Violation,
 };
@@ -76,16 +77,17 @@ fn with_exact_predictions_the_closed_loop_sees_the_open_loop_takeover() {
     let template = problem(&setup, experience.weights.clone(), Vec::new());
     let (first, _) = plan_problem(&planner, &experience, &template, &[], &options).unwrap();
     let plan = planner.plan(&first).unwrap();
-    let expected = setup.expected(&StylePreset::Aggressive.style()).unwrap();
+    let user = SimulatedUser::paper(StylePreset::Aggressive.style()).unwrap();
+    let expected = user.nominal(&setup).unwrap();
 
-    let open = execute(&setup, plan.clone(), expected, 0.3).unwrap();
+    let open = execute(&setup, plan.clone(), &user, &expected).unwrap();
     let driver = ClosedLoop::new(planner.config().clone(), 1, None).unwrap();
     let (driven, stats) = driver
         .drive(&setup, &experience, &options, &plan, false)
         .unwrap();
     assert_eq!(stats.replans, k - 2, "{stats:?}");
     assert_eq!(stats.replan_failures, 0);
-    let closed = execute(&setup, driven, expected, 0.3).unwrap();
+    let closed = execute(&setup, driven, &user, &expected).unwrap();
 
     let open_takeover = open
         .takeover
