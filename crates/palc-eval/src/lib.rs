@@ -36,8 +36,8 @@ pub mod config;
 mod error;
 #[cfg(feature = "plot")]
 mod experiments;
-#[cfg(feature = "plot")]
 pub mod families_report;
+#[cfg(feature = "plot")]
 pub mod figures;
 pub mod harness_runs;
 pub mod manifest;
