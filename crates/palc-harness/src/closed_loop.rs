@@ -35,13 +35,13 @@
 
 use palc_aggregator::{AggregatorOptions, Experience, plan_problem};
 use palc_planner::{Plan, Planner, PlannerConfig, Position, State, Weights, features};
-use palc_traffic::{EgoState, Scene};
+use palc_traffic::Scene;
 use palc_zone_filter::StepScene;
 use serde::{Deserialize, Serialize};
 
 use crate::HarnessError;
 use crate::config::LearnConfig;
-use crate::drive::problem;
+use crate::drive::{ego_state, problem};
 use crate::safety::{SafetyMetrics, SafetyMonitor, Violation};
 use crate::setup::Setup;
 
@@ -457,13 +457,4 @@ fn safety_from(
         monitor.observe(step + i, &rollout);
     }
     Ok(monitor.metrics())
-}
-
-fn ego_state(setup: &Setup, state: &State) -> EgoState {
-    EgoState {
-        s: state.s + setup.origin_s,
-        l: state.l,
-        v: state.v.max(0.0),
-        heading: state.phi,
-    }
 }

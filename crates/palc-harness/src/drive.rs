@@ -220,7 +220,8 @@ pub fn plan_safety(setup: &Setup, plan: &Plan) -> Result<SafetyMetrics, HarnessE
     Ok(monitor.metrics())
 }
 
-fn ego_state(setup: &Setup, state: &State) -> EgoState {
+/// The scene's ego state of a plan state (plan frame, `s` from the trigger).
+pub(crate) fn ego_state(setup: &Setup, state: &State) -> EgoState {
     EgoState {
         s: state.s + setup.origin_s,
         l: state.l,
