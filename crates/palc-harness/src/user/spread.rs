@@ -100,10 +100,9 @@ pub struct ParameterSpread {
 }
 
 impl ParameterSpread {
-    /// Checks every half-width, naming the field under `table`
-    /// (`{table}.reaction_s.absolute`).
-    pub fn validate(&self, table: &str) -> Result<(), HarnessError> {
-        let named = [
+    /// Every parameter's half-width with its name in the TOML table.
+    fn named(&self) -> [(&'static str, Option<Draw>); 9] {
+        [
             ("start_threshold", self.start_threshold),
             ("duration_s", self.duration_s),
             ("reaction_s", self.reaction_s),
@@ -113,8 +112,13 @@ impl ParameterSpread {
             ("max_acceleration_mps2", self.max_acceleration_mps2),
             ("comfort_time_gap_s", self.comfort_time_gap_s),
             ("comfort_ttc_s", self.comfort_ttc_s),
-        ];
-        for (name, draw) in named {
+        ]
+    }
+
+    /// Checks every half-width, naming the field under `table`
+    /// (`{table}.reaction_s.absolute`).
+    pub fn validate(&self, table: &str) -> Result<(), HarnessError> {
+        for (name, draw) in self.named() {
             if let Some(draw) = draw {
                 let kind = match draw {
                     Draw::Relative(_) => "relative",
@@ -151,22 +155,10 @@ impl Spread {
 
     /// Whether any parameter is drawn with a positive half-width.
     pub fn is_active(&self) -> bool {
-        let p = &self.parameters;
         self.relative > 0.0
-            || [
-                p.start_threshold,
-                p.duration_s,
-                p.reaction_s,
-                p.min_lead_gap_s,
-                p.min_lag_gap_s,
-                p.peak_fraction,
-                p.max_acceleration_mps2,
-                p.comfort_time_gap_s,
-                p.comfort_ttc_s,
-            ]
-            .iter()
-            .flatten()
-            .any(|d| d.half_width() > 0.0)
+            || (self.parameters.named().iter())
+                .filter_map(|(_, draw)| *draw)
+                .any(|d| d.half_width() > 0.0)
     }
 
     /// One draw of the user's parameters for the next lane change. The draws are
