@@ -158,9 +158,16 @@ impl Planner {
     /// The warm start is used only when `previous` is the last plan this planner
     /// returned (the backend still holds its multipliers) and the bound pattern is
     /// unchanged; otherwise, and with [`Backend::Clarabel`], this is `plan(problem)`.
+    /// A warm start is a hint, never a risk: when the warm-started solve fails (a
+    /// shifted start far from the new optimum can exhaust the iterations, as the
+    /// re-plan property test found), the problem is solved again from the cold start,
+    /// so `replan` fails only where `plan` would.
     pub fn replan(&mut self, problem: &Problem, previous: &Plan) -> Result<Plan, PlanError> {
         let warm = self.last == Some(PlanKey::of(previous));
-        self.solve(problem, warm)
+        match self.solve(problem, warm) {
+            Err(_) if warm => self.solve(problem, false),
+            result => result,
+        }
     }
 
     /// Validates, assembles and solves; `warm`: start from the last plan shifted.
