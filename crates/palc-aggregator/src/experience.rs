@@ -7,7 +7,7 @@ use palc_planner::Weights;
 use palc_zone_filter::ZoneModel;
 use serde::{Deserialize, Serialize};
 
-use crate::{AggregatorError, ApprenticeshipState, resample_weights};
+use crate::{AggregatorError, ApprenticeshipState, Onset, resample_weights};
 
 /// The experience format version this build writes and the newest it reads.
 pub const EXPERIENCE_FORMAT_VERSION: u32 = 1;
@@ -29,9 +29,10 @@ pub struct ExperienceMetadata {
 }
 
 /// What has been learned: the zone model with its statistics, the 10 x K weight
-/// matrix, the apprenticeship state and metadata.
+/// matrix, the apprenticeship state, the user's observed starts and metadata.
 ///
-/// Saved as JSON `{format_version, metadata, weights, zone, apprenticeship}`; the
+/// Saved as JSON `{format_version, metadata, weights, zone, apprenticeship,
+/// anchor_s, onsets}` (the last two may be absent in older files); the
 /// zone is the zone filter's own versioned serialization. Numbers round-trip
 /// bit-exactly (shortest representation on write, correctly rounded parse).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -46,6 +47,12 @@ pub struct Experience {
     pub zone: Option<ZoneModel>,
     /// The apprenticeship rule's projection point, once that rule has run.
     pub apprenticeship: Option<ApprenticeshipState>,
+    /// The user's start in the weights' time base (s after the start of the plan):
+    /// observed in this scene, or predicted when the experience was carried into it.
+    /// `None` until a start has been observed.
+    pub anchor_s: Option<f64>,
+    /// The user's observed starts, one per scene learned in, oldest first.
+    pub onsets: Vec<Onset>,
 }
 
 /// The file layout: the version first, so that a reader sees it before anything else.
@@ -57,6 +64,10 @@ struct Stored {
     weights: Weights,
     zone: Option<ZoneModel>,
     apprenticeship: Option<ApprenticeshipState>,
+    #[serde(default)]
+    anchor_s: Option<f64>,
+    #[serde(default)]
+    onsets: Vec<Onset>,
 }
 
 #[derive(Deserialize)]
@@ -88,6 +99,8 @@ impl Experience {
             weights,
             zone: None,
             apprenticeship: None,
+            anchor_s: None,
+            onsets: Vec::new(),
         };
         experience.validate()?;
         Ok(experience)
@@ -112,6 +125,17 @@ impl Experience {
             return Err(AggregatorError::Resample {
                 reason: "the weight matrix has no column".into(),
             });
+        }
+        if let Some(anchor) = self.anchor_s {
+            if !anchor.is_finite() {
+                return Err(AggregatorError::NonFinite {
+                    field: "anchor_s".into(),
+                    value: anchor,
+                });
+            }
+        }
+        for (i, onset) in self.onsets.iter().enumerate() {
+            onset.validate(i)?;
         }
         let matrices = std::iter::once(("weights", self.weights.columns())).chain(
             self.apprenticeship
@@ -150,6 +174,8 @@ impl Experience {
             weights: self.weights.clone(),
             zone: self.zone.clone(),
             apprenticeship: self.apprenticeship.clone(),
+            anchor_s: self.anchor_s,
+            onsets: self.onsets.clone(),
         };
         let mut bytes =
             serde_json::to_vec_pretty(&stored).map_err(|e| AggregatorError::Serialize {
@@ -202,6 +228,8 @@ impl Experience {
             weights: stored.weights,
             zone: stored.zone,
             apprenticeship: stored.apprenticeship,
+            anchor_s: stored.anchor_s,
+            onsets: stored.onsets,
         };
         experience.validate().map_err(|e| corrupt(e.to_string()))?;
         Ok(experience)

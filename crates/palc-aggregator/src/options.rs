@@ -34,6 +34,24 @@ pub struct AggregatorOptions {
     pub zone: ZoneConfig,
     /// How the zone is projected onto lateral bounds.
     pub bounds: BoundsConfig,
+    /// How the learned weights carry into another scene.
+    pub representation: Representation,
+}
+
+/// How learned weights carry into another scene (docs/paper-mapping.md,
+/// "Experience in relative space").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Representation {
+    /// Indexed by time since the start of the plan, as learned: the lane change
+    /// starts as long after the plan's start as it did where it was learned.
+    TimeIndexed,
+    /// Anchored at the user's start, found in relative space: the weights are
+    /// shifted so that the learned start falls where the new scene predicts the
+    /// relative state the user started in (the time headway, time to collision
+    /// or gap to the vehicle ahead, and the target lane's gaps, [`crate::Onset`]).
+    #[default]
+    RelativeOnset,
 }
 
 impl AggregatorOptions {
@@ -46,6 +64,7 @@ impl AggregatorOptions {
             correction: CorrectionRule::Apprenticeship(ApprenticeshipRule::default()),
             learnable_rows: LearnableRows::ALL,
             use_zone: true,
+            representation: Representation::TimeIndexed,
             ..AggregatorOptions::default()
         }
     }

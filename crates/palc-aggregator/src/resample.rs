@@ -34,7 +34,34 @@ pub fn resample_weights(
     horizon: usize,
     to_dt: f64,
 ) -> Result<Weights, AggregatorError> {
-    let columns = resample_columns(weights.columns(), from_dt, horizon, to_dt)?;
+    let columns = resample_columns(weights.columns(), from_dt, horizon, to_dt, 0.0)?;
+    Ok(Weights::from_columns(columns))
+}
+
+/// [`resample_weights`] with the time base moved by `shift_s`: new column `c'`
+/// takes the old value at `t' − shift_s`, so that what the old matrix did at time
+/// `t` the new one does at `t + shift_s`. Before the old start
+/// (`t' − shift_s < 0`) the first old column is held, beyond its end the last.
+///
+/// This is how an experience anchored at the user's start carries into a scene
+/// where that start is predicted `shift_s` later (or earlier, for a negative
+/// shift) after the start of the plan.
+///
+/// # Errors
+/// As [`resample_weights`], and for a `shift_s` that is not finite.
+pub fn resample_weights_shifted(
+    weights: &Weights,
+    from_dt: f64,
+    horizon: usize,
+    to_dt: f64,
+    shift_s: f64,
+) -> Result<Weights, AggregatorError> {
+    if !shift_s.is_finite() {
+        return Err(AggregatorError::Resample {
+            reason: format!("shift_s = {shift_s} s must be finite"),
+        });
+    }
+    let columns = resample_columns(weights.columns(), from_dt, horizon, to_dt, shift_s)?;
     Ok(Weights::from_columns(columns))
 }
 
@@ -44,6 +71,7 @@ pub(crate) fn resample_columns(
     from_dt: f64,
     horizon: usize,
     to_dt: f64,
+    shift_s: f64,
 ) -> Result<Vec<[f64; FEATURE_COUNT]>, AggregatorError> {
     let fail = |reason: String| Err(AggregatorError::Resample { reason });
     if columns.is_empty() {
@@ -57,13 +85,13 @@ pub(crate) fn resample_columns(
             return fail(format!("{name} = {dt} s must be finite and > 0"));
         }
     }
-    if horizon == columns.len() && from_dt == to_dt {
+    if horizon == columns.len() && from_dt == to_dt && shift_s == 0.0 {
         return Ok(columns.to_vec());
     }
     let last = columns.len() - 1;
     Ok((0..horizon)
         .map(|c| {
-            let position = c as f64 * to_dt / from_dt;
+            let position = ((c as f64 * to_dt - shift_s) / from_dt).max(0.0);
             let below = position.floor();
             if below >= last as f64 {
                 return columns[last];
@@ -108,6 +136,22 @@ mod tests {
     fn longer_horizon_holds_last_column() {
         let r = resample_weights(&ramp(2), 0.1, 4, 0.1).unwrap();
         assert_eq!(r.row(3).collect::<Vec<_>>(), vec![0.0, 1.0, 1.0, 1.0]);
+    }
+
+    #[test]
+    fn a_shift_moves_the_time_base_and_holds_both_ends() {
+        let w = ramp(4); // values 0, 1, 2, 3 at t = 0, 0.1, 0.2, 0.3
+        let later = resample_weights_shifted(&w, 0.1, 6, 0.1, 0.15).unwrap();
+        let got: Vec<f64> = later.row(0).collect();
+        let expected = [0.0, 0.0, 0.5, 1.5, 2.5, 3.0];
+        for (g, e) in got.iter().zip(expected) {
+            assert!((g - e).abs() < 1e-12, "{got:?}");
+        }
+        let earlier = resample_weights_shifted(&w, 0.1, 3, 0.1, -0.1).unwrap();
+        assert_eq!(earlier.row(0).collect::<Vec<_>>(), vec![1.0, 2.0, 3.0]);
+        let none = resample_weights_shifted(&w, 0.1, 4, 0.1, 0.0).unwrap();
+        assert_eq!(none, w);
+        assert!(resample_weights_shifted(&w, 0.1, 4, 0.1, f64::NAN).is_err());
     }
 
     #[test]

@@ -216,6 +216,8 @@ pub fn learn_from_lesson(
             weights: outcome.weights,
             zone,
             apprenticeship: outcome.apprenticeship,
+            anchor_s: experience.anchor_s,
+            onsets: experience.onsets.clone(),
         },
         expert,
         plan,

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use palc_aggregator::{
-    AggregatorError, ApprenticeshipState, EXPERIENCE_FORMAT_VERSION, Experience,
+    AggregatorError, ApprenticeshipState, EXPERIENCE_FORMAT_VERSION, Experience, Onset,
 };
 use palc_planner::{FEATURE_COUNT, Features, Weights};
 use palc_zone_filter::{Label, Sample, ZoneConfig, ZoneModel};
@@ -49,6 +49,17 @@ fn sample_experience() -> Experience {
         updates: 3,
     });
     experience.metadata.lessons = 3;
+    experience.anchor_s = Some(4.397);
+    experience.onsets = vec![Onset {
+        scenario: "collector-slow / 50 m / seed 1 / neutral".into(),
+        time_s: 4.397,
+        time_headway_s: 1.2237,
+        ttc_s: Some(5.51),
+        gap_m: 24.6,
+        lead_time_gap_s: None,
+        lag_time_gap_s: Some(0.031),
+        observations: 2,
+    }];
     experience
 }
 
@@ -220,6 +231,31 @@ fn newer_version_is_refused_naming_both_versions() {
         "{message}"
     );
     fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn a_file_without_onsets_loads_with_none() {
+    let dir = scratch();
+    let path = dir.join("older.json");
+    let mut experience = sample_experience();
+    experience.save(&path).unwrap();
+    let mut json: serde_json::Value = serde_json::from_slice(&fs::read(&path).unwrap()).unwrap();
+    let object = json.as_object_mut().unwrap();
+    object.remove("anchor_s");
+    object.remove("onsets");
+    fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+    let loaded = Experience::load(&path).unwrap();
+    experience.anchor_s = None;
+    experience.onsets.clear();
+    assert_eq!(loaded, experience);
+}
+
+#[test]
+fn a_non_finite_onset_is_refused_naming_it() {
+    let mut experience = sample_experience();
+    experience.onsets[0].gap_m = f64::INFINITY;
+    let message = experience.validate().unwrap_err().to_string();
+    assert!(message.contains("onsets[0].gap_m"), "{message}");
 }
 
 #[test]

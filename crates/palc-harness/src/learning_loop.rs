@@ -7,8 +7,8 @@
 use std::time::Instant;
 
 use palc_aggregator::{
-    AggregatorError, AggregatorOptions, Experience, StepOutcome, Timings, learn_from_lesson,
-    plan_problem,
+    AggregatorError, AggregatorOptions, Experience, Representation, StepOutcome, Timings,
+    learn_from_lesson, plan_problem, resample_weights_shifted,
 };
 use palc_planner::{LateralBoundsMode, Plan, Planner, PlannerConfig, Problem};
 
@@ -20,6 +20,7 @@ use crate::learn::{RunResult, aggregator_options, prepare_for};
 use crate::lesson::{lesson, scenes, zone_feature_set};
 use crate::method::Method;
 use crate::observer::{LessonEvent, Observer};
+use crate::onset::{observed_start_s, onset_at, predicted_start_s};
 use crate::record::{LaneChangeRecord, Outcome, RunSummary};
 use crate::safety::{SafetyMetrics, Violation};
 use crate::setup::Setup;
@@ -123,7 +124,7 @@ impl LearningLoop {
         }
         let options = aggregator_options(config);
         options.validate()?;
-        let experience = starting_experience(config, &setup, experience)?;
+        let experience = starting_experience(config, &setup, experience, &options)?;
         let mut planner = Planner::new(PlannerConfig {
             horizon: setup.horizon,
             dt: setup.dt,
@@ -398,6 +399,7 @@ impl LearningLoop {
                 self.pending_times = outcome.timings;
                 self.experience = outcome.experience;
                 self.next_plan = outcome.plan;
+                self.observe_onset(drive, takeover_step);
             }
             Err(error) => {
                 observer.lesson(&LessonEvent::Failed {
@@ -413,6 +415,27 @@ impl LearningLoop {
             }
         }
         Ok(())
+    }
+
+    /// Records the user's start seen in the lesson of `drive` (its profile from the
+    /// takeover on) in the experience: merged into this scene's onset, which
+    /// becomes the anchor of the weights.
+    fn observe_onset(&mut self, drive: &Drive, takeover_step: usize) {
+        let driven_l: Vec<f64> = drive.driven.iter().map(|x| x.l).collect();
+        let observed = observed_start_s(&driven_l, takeover_step, self.setup.dt, self.setup.target_l)
+            .and_then(|start| onset_at(&self.setup, start));
+        let Some(observed) = observed else { return };
+        let onsets = &mut self.experience.onsets;
+        let merged = match onsets.last() {
+            Some(last) if last.scenario == observed.scenario => {
+                let merged = last.merged(&observed);
+                onsets.pop();
+                merged
+            }
+            _ => observed,
+        };
+        self.experience.anchor_s = Some(merged.time_s);
+        onsets.push(merged);
     }
 
     /// The summary of a run that ended with `outcome`.
@@ -435,18 +458,43 @@ impl LearningLoop {
     }
 }
 
-/// The experience a run starts from: `previous` carried into this scenario (weights
-/// resampled to its horizon and step), or a fresh one with the standard ALC's weights.
+/// The experience a run starts from: `previous` carried into this scenario, or a
+/// fresh one with the standard ALC's weights.
+///
+/// The weights are resampled to this scenario's horizon and step. With
+/// [`Representation::RelativeOnset`] and a user's start observed before, they are
+/// also shifted so that the learned start falls where this scene predicts the
+/// relative state the user started in ([`predicted_start_s`]); without an
+/// observed start, or when none is predicted here, they keep their time base.
 fn starting_experience(
     config: &LearnConfig,
     setup: &Setup,
     previous: Option<&Experience>,
+    options: &AggregatorOptions,
 ) -> Result<Experience, HarnessError> {
     let (k, dt) = (setup.horizon, setup.dt);
     match previous {
         Some(previous) => {
             let mut carried = previous.clone();
-            carried.weights = previous.weights_for(k, dt)?;
+            let anchored = match (options.representation, previous.anchor_s) {
+                (Representation::RelativeOnset, Some(anchor)) => {
+                    predicted_start_s(setup, &previous.onsets).map(|start| (anchor, start))
+                }
+                _ => None,
+            };
+            match anchored {
+                Some((anchor, start)) => {
+                    carried.weights = resample_weights_shifted(
+                        &previous.weights,
+                        previous.metadata.dt,
+                        k,
+                        dt,
+                        start - anchor,
+                    )?;
+                    carried.anchor_s = Some(start);
+                }
+                None => carried.weights = previous.weights_for(k, dt)?,
+            }
             carried.metadata.dt = dt;
             carried.metadata.scenario = config.label();
             Ok(carried)

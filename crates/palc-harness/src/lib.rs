@@ -40,6 +40,7 @@ mod learning_loop;
 mod lesson;
 mod method;
 mod observer;
+mod onset;
 mod record;
 pub mod safety;
 mod setup;

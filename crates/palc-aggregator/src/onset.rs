@@ -1,0 +1,125 @@
+//! Where a user starts to change lanes, in the relative space the user sees: the
+//! anchor that carries a learned lane change from one scene into another.
+//!
+//! The weights of an [`crate::Experience`] are indexed by time since the start of
+//! the plan. What a user does once the lane change has started (its lateral
+//! profile) does not depend on the scene; *when* it starts does, through what the
+//! user sees: the time headway, time to collision and gap to the vehicle ahead,
+//! and the gaps on the target lane. An [`Onset`] records that relative state at
+//! the user's observed start, so that a new scene can find the moment it recurs
+//! and shift the weights there ([`crate::resample_weights_shifted`]).
+
+use serde::{Deserialize, Serialize};
+
+use crate::AggregatorError;
+
+/// The relative state at a user's start of a lane change, observed in one scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Onset {
+    /// The scene it was observed in (free text, e.g. `collector-high / 40 m`).
+    pub scenario: String,
+    /// Time of the start after the start of that scene's plan (s).
+    pub time_s: f64,
+    /// Time headway to the preceding vehicle: net gap over ego speed (s).
+    pub time_headway_s: f64,
+    /// Time to collision with the preceding vehicle (s); `None` when not closing.
+    pub ttc_s: Option<f64>,
+    /// Net gap to the preceding vehicle (m).
+    pub gap_m: f64,
+    /// Net gap to the target lane's leader over the ego speed (s), when that gap
+    /// held the user back: the leader was alongside or absent at an earlier step
+    /// of the plan, so the user waited for this gap. `None` otherwise.
+    pub lead_time_gap_s: Option<f64>,
+    /// Net gap to the target lane's follower over the follower's speed (s), when
+    /// that gap held the user back (as `lead_time_gap_s`). `None` otherwise.
+    pub lag_time_gap_s: Option<f64>,
+    /// Lessons this onset is the mean of.
+    pub observations: u64,
+}
+
+impl Onset {
+    /// Checks that every value is finite (the time also non-negative), naming the
+    /// field of the first that is not.
+    pub fn validate(&self, index: usize) -> Result<(), AggregatorError> {
+        let values = [
+            ("time_s", Some(self.time_s)),
+            ("time_headway_s", Some(self.time_headway_s)),
+            ("ttc_s", self.ttc_s),
+            ("gap_m", Some(self.gap_m)),
+            ("lead_time_gap_s", self.lead_time_gap_s),
+            ("lag_time_gap_s", self.lag_time_gap_s),
+        ];
+        for (name, value) in values {
+            if let Some(x) = value {
+                if !x.is_finite() || (name == "time_s" && x < 0.0) {
+                    return Err(AggregatorError::NonFinite {
+                        field: format!("onsets[{index}].{name}"),
+                        value: x,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The running mean of this onset and `other`, observed in the same scene:
+    /// each value weighted by its number of observations (an option present in
+    /// only one of the two is kept).
+    pub fn merged(&self, other: &Onset) -> Onset {
+        let (a, b) = (self.observations as f64, other.observations as f64);
+        let n = (a + b).max(1.0);
+        let mean = |x: f64, y: f64| (a * x + b * y) / n;
+        let option = |x: Option<f64>, y: Option<f64>| match (x, y) {
+            (Some(x), Some(y)) => Some(mean(x, y)),
+            (x, y) => x.or(y),
+        };
+        Onset {
+            scenario: other.scenario.clone(),
+            time_s: mean(self.time_s, other.time_s),
+            time_headway_s: mean(self.time_headway_s, other.time_headway_s),
+            ttc_s: option(self.ttc_s, other.ttc_s),
+            gap_m: mean(self.gap_m, other.gap_m),
+            lead_time_gap_s: option(self.lead_time_gap_s, other.lead_time_gap_s),
+            lag_time_gap_s: option(self.lag_time_gap_s, other.lag_time_gap_s),
+            observations: self.observations + other.observations,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn onset(time_s: f64, headway: f64, lag: Option<f64>, n: u64) -> Onset {
+        Onset {
+            scenario: "a".into(),
+            time_s,
+            time_headway_s: headway,
+            ttc_s: None,
+            gap_m: 20.0 * headway,
+            lead_time_gap_s: None,
+            lag_time_gap_s: lag,
+            observations: n,
+        }
+    }
+
+    #[test]
+    fn merging_is_a_mean_weighted_by_observations() {
+        let m = onset(1.0, 1.0, Some(4.0), 3).merged(&onset(2.0, 2.0, None, 1));
+        assert!((m.time_s - 1.25).abs() < 1e-12);
+        assert!((m.time_headway_s - 1.25).abs() < 1e-12);
+        assert_eq!(m.lag_time_gap_s, Some(4.0));
+        assert_eq!(m.observations, 4);
+    }
+
+    #[test]
+    fn non_finite_values_are_named() {
+        let mut bad = onset(1.0, 1.0, None, 1);
+        bad.lag_time_gap_s = Some(f64::NAN);
+        let message = bad.validate(2).unwrap_err().to_string();
+        assert!(message.contains("onsets[2].lag_time_gap_s"), "{message}");
+        assert!(onset(-1.0, 1.0, None, 1).validate(0).is_err());
+        assert!(onset(1.0, 1.0, None, 1).validate(0).is_ok());
+    }
+}

@@ -1,0 +1,337 @@
+//! The user's start of a lane change in relative space: observed in a lesson,
+//! predicted in a new scene (docs/paper-mapping.md, "Experience in relative space").
+//!
+//! A takeover shows the user's own lateral profile from the takeover on. Its start
+//! is found by fitting a quintic (the paper's lane-change model, Section III.A)
+//! through two crossings of it: with `x(p)` the inverse of
+//! `p(x) = 10x³ − 15x⁴ + 6x⁵`, crossings of the fractions `p_a < p_b` of the lane
+//! change at `t_a` and `t_b` give the duration `D = (t_b − t_a) / (x(p_b) − x(p_a))`
+//! and the start `t_a − x(p_a) · D`. The crossings are interpolated between steps,
+//! so the start is found to a fraction of a step; another profile (cosine, a table)
+//! biases it by a few percent of its duration.
+//!
+//! The relative state at that start ([`Onset`]: time headway, time to collision
+//! and gap to the vehicle ahead, and a target-lane gap when it held the user back)
+//! is what carries. In a new scene the start is predicted with the structure of a
+//! gap-acceptance driver: the user decides when the decision feature falls to
+//! the learned threshold, then starts at the first step from there where the
+//! target-lane gaps are at least the learned ones ([`predicted_start_s`]).
+
+use palc_aggregator::Onset;
+
+use crate::setup::Setup;
+use crate::user::Situation;
+
+/// The lower fraction of the lane change whose crossing anchors the fit: low
+/// enough to lie early in the move, high enough to lie clear of the takeover's
+/// 0.3 m (8.6 % of a 3.5 m lane) in the usual first lesson.
+const LOWER_FRACTION: f64 = 0.1;
+/// The distance between the two fitted fractions: wide enough that a step's
+/// interpolation error is small against it, and the upper one stays at most 0.9.
+const FRACTION_SPAN: f64 = 0.4;
+/// The smallest span accepted when the user is past the lower fraction at the
+/// takeover (the upper fraction is then capped at 0.9).
+const MIN_FRACTION_SPAN: f64 = 0.2;
+/// How long before a start a target-lane vehicle alongside counts as the reason
+/// the user waited (s): a second covers a reaction after the gap opens (the
+/// `reaction` family's 0.8 s) without reaching back to unrelated moments.
+const HELD_BACK_WINDOW_S: f64 = 1.0;
+/// Relative spread below which a decision feature counts as consistent across
+/// scenes.
+const CONSISTENT_SPREAD: f64 = 0.1;
+
+/// The quintic lane-change profile `p(x)` on `[0, 1]`.
+fn quintic(x: f64) -> f64 {
+    x * x * x * (10.0 + x * (-15.0 + 6.0 * x))
+}
+
+/// The inverse of [`quintic`] on `[0, 1]`, by bisection (it is increasing).
+fn quintic_inverse(p: f64) -> f64 {
+    let (mut low, mut high) = (0.0, 1.0);
+    for _ in 0..60 {
+        let mid = 0.5 * (low + high);
+        if quintic(mid) < p {
+            low = mid;
+        } else {
+            high = mid;
+        }
+    }
+    0.5 * (low + high)
+}
+
+/// The time (s) at which the fraction `profile` first reaches `level` at or
+/// after `from`, interpolated between the two steps around it.
+fn crossing_s(profile: &[f64], from: usize, level: f64, dt: f64) -> Option<f64> {
+    (from + 1..profile.len()).find_map(|i| {
+        let (a, b) = (profile[i - 1], profile[i]);
+        (a < level && b >= level).then(|| (i - 1) as f64 * dt + dt * (level - a) / (b - a))
+    })
+}
+
+/// The user's start (s after the start of the plan) seen in a lesson: the lateral
+/// positions `driven_l` driven by the user from `takeover_step` on, towards
+/// `target_l` from 0. `None` when the profile after the takeover is too short to
+/// fit (the user was past 70 % of the lane change at the takeover).
+pub(crate) fn observed_start_s(
+    driven_l: &[f64],
+    takeover_step: usize,
+    dt: f64,
+    target_l: f64,
+) -> Option<f64> {
+    if target_l == 0.0 || takeover_step >= driven_l.len() {
+        return None;
+    }
+    let profile: Vec<f64> = driven_l.iter().map(|l| l / target_l).collect();
+    let at_takeover = profile[takeover_step];
+    let lower = LOWER_FRACTION.max(at_takeover + 0.01);
+    let upper = (lower + FRACTION_SPAN).min(0.9);
+    if upper - lower < MIN_FRACTION_SPAN {
+        return None;
+    }
+    let t_a = crossing_s(&profile, takeover_step, lower, dt)?;
+    let t_b = crossing_s(&profile, takeover_step, upper, dt)?;
+    let (x_a, x_b) = (quintic_inverse(lower), quintic_inverse(upper));
+    let duration = (t_b - t_a) / (x_b - x_a);
+    Some((t_a - x_a * duration).max(0.0))
+}
+
+/// The step at which a start at `start_s` happened: decisions are taken at
+/// control steps. At least 1, so that a step before it exists.
+fn start_step(setup: &Setup, start_s: f64) -> Option<usize> {
+    let last = setup.situations.len().checked_sub(1)?;
+    Some(((start_s / setup.dt).round() as usize).clamp(1, last.max(1)).min(last))
+}
+
+/// The threshold of a feature revealed by a start at step `step`: the midpoint
+/// between its value at that step (where the start condition held) and at the
+/// step before (where it did not yet). `None` when the feature is missing or
+/// not finite at the start.
+fn revealed(setup: &Setup, step: usize, field: impl Fn(&Situation) -> Option<f64>) -> Option<f64> {
+    let at = field(setup.situations.get(step)?).filter(|x| x.is_finite())?;
+    let before = step
+        .checked_sub(1)
+        .and_then(|i| field(&setup.situations[i]))
+        .filter(|x| x.is_finite());
+    Some(before.map_or(at, |b| 0.5 * (at + b)))
+}
+
+/// The target-lane gaps as time gaps (s): `(lead, lag)`.
+fn lead_time_gap(s: &Situation) -> Option<f64> {
+    s.target_lead_times_s().map(|(gap, _)| gap)
+}
+fn lag_time_gap(s: &Situation) -> Option<f64> {
+    s.target_lag_times_s().map(|(gap, _)| gap)
+}
+fn ttc(s: &Situation) -> Option<f64> {
+    Some(s.preceding_ttc_s()).filter(|t| t.is_finite())
+}
+
+/// Whether a target-lane gap held the user back before the start at `step`:
+/// within [`HELD_BACK_WINDOW_S`] before it its vehicle was alongside (gap ≤ 0) or
+/// absent, while it is present at the start.
+fn held_back(setup: &Setup, step: usize, gap: fn(&Situation) -> Option<f64>) -> bool {
+    let window = (HELD_BACK_WINDOW_S / setup.dt).round() as usize;
+    let present_at_start = gap(&setup.situations[step]).is_some();
+    present_at_start
+        && setup.situations[step.saturating_sub(window)..step]
+            .iter()
+            .any(|s| gap(s).is_none_or(|g| g <= 0.0))
+}
+
+/// The relative state of `setup` revealed by the user's start at `start_s`, as an
+/// [`Onset`] of one observation: each feature's threshold between its values at
+/// the start's step and the step before ([`revealed`]). `None` when the vehicle
+/// ahead is gone by then.
+pub(crate) fn onset_at(setup: &Setup, start_s: f64) -> Option<Onset> {
+    let step = start_step(setup, start_s)?;
+    let binding = |gap: fn(&Situation) -> Option<f64>| {
+        held_back(setup, step, gap)
+            .then(|| revealed(setup, step, gap))
+            .flatten()
+    };
+    Some(Onset {
+        scenario: setup.label.clone(),
+        time_s: start_s,
+        time_headway_s: revealed(setup, step, |s| Some(s.time_headway_s))?,
+        ttc_s: revealed(setup, step, ttc),
+        gap_m: revealed(setup, step, |s| Some(s.preceding_gap_m))?,
+        lead_time_gap_s: binding(lead_time_gap),
+        lag_time_gap_s: binding(lag_time_gap),
+        observations: 1,
+    })
+}
+
+/// The feature of the vehicle ahead whose fall to a threshold decides the lane
+/// change.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Decision {
+    TimeHeadway,
+    TimeToCollision,
+    Gap,
+}
+
+impl Decision {
+    fn of_situation(self, s: &Situation) -> Option<f64> {
+        match self {
+            Decision::TimeHeadway => Some(s.time_headway_s),
+            Decision::TimeToCollision => ttc(s),
+            Decision::Gap => Some(s.preceding_gap_m),
+        }
+    }
+
+    fn of_onset(self, onset: &Onset) -> Option<f64> {
+        match self {
+            Decision::TimeHeadway => Some(onset.time_headway_s),
+            Decision::TimeToCollision => onset.ttc_s,
+            Decision::Gap => Some(onset.gap_m),
+        }
+    }
+}
+
+/// The decision feature and its threshold learned from `onsets`.
+///
+/// Onsets a target-lane gap held back only bound the decision from below; the
+/// others give it. The threshold is the largest value seen (the earliest start the
+/// user has shown). The feature is the time headway (the paper's user model and
+/// the usual measure of following) unless, over onsets from two or more scenes,
+/// it varies by more than [`CONSISTENT_SPREAD`] while the time to collision or the
+/// gap does not; then the most consistent of those.
+fn decision(onsets: &[Onset]) -> (Decision, f64) {
+    let free: Vec<&Onset> = onsets
+        .iter()
+        .filter(|o| o.lead_time_gap_s.is_none() && o.lag_time_gap_s.is_none())
+        .collect();
+    let informative: Vec<&Onset> = if free.is_empty() {
+        onsets.iter().collect()
+    } else {
+        free
+    };
+    let spread = |feature: Decision| -> Option<(f64, f64)> {
+        let values: Vec<f64> = (informative.iter())
+            .map(|o| feature.of_onset(o))
+            .collect::<Option<_>>()?;
+        let max = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        let min = values.iter().copied().fold(f64::INFINITY, f64::min);
+        (max > 0.0).then(|| ((max - min) / max, max))
+    };
+    let headway = spread(Decision::TimeHeadway).unwrap_or((0.0, 0.0));
+    if informative.len() >= 2 && headway.0 > CONSISTENT_SPREAD {
+        let best = [Decision::TimeToCollision, Decision::Gap]
+            .into_iter()
+            .filter_map(|d| spread(d).map(|(spread, max)| (d, spread, max)))
+            .filter(|&(_, spread, _)| spread <= CONSISTENT_SPREAD)
+            .min_by(|a, b| a.1.total_cmp(&b.1));
+        if let Some((feature, _, threshold)) = best {
+            return (feature, threshold);
+        }
+    }
+    (Decision::TimeHeadway, headway.1)
+}
+
+/// The smallest target-lane time gap that held the user back in `onsets`, or 0
+/// (a vehicle alongside is never accepted) when none did.
+fn acceptance(onsets: &[Onset], gap: fn(&Onset) -> Option<f64>) -> f64 {
+    onsets
+        .iter()
+        .filter_map(gap)
+        .reduce(f64::min)
+        .map_or(0.0, |g| g.max(0.0))
+}
+
+/// The user's start (s after the start of the plan) predicted in `setup` from the
+/// observed `onsets`: the first step at which the decision feature has fallen to
+/// its threshold, then the first step from there at which the target-lane gaps
+/// are at least the learned ones. `None` without onsets, or when the prediction
+/// does not start within the search window.
+pub(crate) fn predicted_start_s(setup: &Setup, onsets: &[Onset]) -> Option<f64> {
+    if onsets.is_empty() {
+        return None;
+    }
+    let (feature, threshold) = decision(onsets);
+    let lead = acceptance(onsets, |o| o.lead_time_gap_s);
+    let lag = acceptance(onsets, |o| o.lag_time_gap_s);
+    let situations = &setup.situations;
+    let decides = |s: &Situation| {
+        s.time_headway_s > 0.0 && feature.of_situation(s).is_some_and(|x| x <= threshold)
+    };
+    let accepts = |s: &Situation| {
+        lead_time_gap(s).is_none_or(|g| g > 0.0 && g >= lead)
+            && lag_time_gap(s).is_none_or(|g| g > 0.0 && g >= lag)
+    };
+    let decided = situations.iter().position(decides)?;
+    let start = decided + situations[decided..].iter().position(accepts)?;
+    Some(start as f64 * setup.dt)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_quintic_inverse_inverts() {
+        for p in [0.0, 0.05, 0.1, 0.5, 0.9, 1.0] {
+            assert!((quintic(quintic_inverse(p)) - p).abs() < 1e-12, "{p}");
+        }
+    }
+
+    /// A quintic lane change starting at `start` (s), sampled at `dt`.
+    fn quintic_profile(start: f64, duration: f64, dt: f64, n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|i| {
+                let x = ((i as f64 * dt - start) / duration).clamp(0.0, 1.0);
+                3.5 * quintic(x)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_start_of_a_quintic_is_found_between_steps() {
+        for (start, duration, takeover) in [(4.23, 2.1, 46), (4.23, 2.1, 30), (1.07, 1.7, 13)] {
+            let profile = quintic_profile(start, duration, 0.1, 120);
+            let found = observed_start_s(&profile, takeover, 0.1, 3.5).unwrap();
+            assert!((found - start).abs() < 0.02, "{found} vs {start}");
+        }
+    }
+
+    #[test]
+    fn a_profile_seen_too_late_gives_no_start() {
+        let profile = quintic_profile(1.0, 2.0, 0.1, 60);
+        // At step 25 the user is past 80 % of the lane change.
+        assert_eq!(observed_start_s(&profile, 25, 0.1, 3.5), None);
+        assert_eq!(observed_start_s(&profile, 5, 0.1, 0.0), None);
+    }
+
+    fn onset(headway: f64, ttc: f64, lag: Option<f64>) -> Onset {
+        Onset {
+            scenario: "s".into(),
+            time_s: 1.0,
+            time_headway_s: headway,
+            ttc_s: Some(ttc),
+            gap_m: 20.0 * headway,
+            lead_time_gap_s: None,
+            lag_time_gap_s: lag,
+            observations: 1,
+        }
+    }
+
+    #[test]
+    fn the_decision_is_the_headway_unless_another_feature_is_consistent() {
+        assert_eq!(decision(&[onset(1.2, 10.0, None)]).0, Decision::TimeHeadway);
+        let headway_user = [onset(1.2, 10.0, None), onset(1.21, 5.0, None)];
+        let (feature, threshold) = decision(&headway_user);
+        assert_eq!(feature, Decision::TimeHeadway);
+        assert!((threshold - 1.21).abs() < 1e-12);
+        let ttc_user = [onset(1.6, 8.0, None), onset(0.8, 8.1, None)];
+        assert_eq!(decision(&ttc_user).0, Decision::TimeToCollision);
+        // An onset held back by a gap does not set the decision.
+        let held = [onset(1.2, 10.0, None), onset(0.3, 2.0, Some(0.1))];
+        assert_eq!(decision(&held), (Decision::TimeHeadway, 1.2));
+    }
+
+    #[test]
+    fn acceptance_is_the_smallest_gap_that_held_the_user_back() {
+        let onsets = [onset(1.2, 10.0, Some(0.4)), onset(1.2, 10.0, Some(0.2))];
+        assert!((acceptance(&onsets, |o| o.lag_time_gap_s) - 0.2).abs() < 1e-12);
+        assert_eq!(acceptance(&onsets, |o| o.lead_time_gap_s), 0.0);
+    }
+}

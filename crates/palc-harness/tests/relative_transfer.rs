@@ -1,0 +1,96 @@
+//! Experience in relative space: the user's start is observed in a lesson, and a
+//! carried experience is anchored where a new scene predicts it
+//! (docs/paper-mapping.md, "Experience in relative space").
+
+use palc_aggregator::{AggregatorOptions, Representation};
+use palc_harness::{
+    CellChoice, LearnConfig, LearningLoop, NoObserver, StylePreset, UserConfig, expectation, run,
+};
+
+fn config(speed_case: &str, headway_m: f64, style: StylePreset) -> LearnConfig {
+    let text = include_str!("../../../configs/learn.toml");
+    let base = LearnConfig::from_toml_str(text).expect("the default config parses");
+    base.with_cell(CellChoice {
+        speed_case: speed_case.into(),
+        headway_m,
+        seed: 1,
+    })
+    .with_user(UserConfig::preset(style))
+}
+
+fn with_representation(config: &LearnConfig, representation: Representation) -> LearnConfig {
+    let mut config = config.clone();
+    config.aggregator = Some(AggregatorOptions {
+        representation,
+        ..AggregatorOptions::default()
+    });
+    config
+}
+
+/// The user's nominal start in the scenario of `config` (s after the plan's start).
+fn true_start_s(config: &LearnConfig) -> f64 {
+    let (_, nominal) = expectation(config).expect("the scenario is sane");
+    nominal.lane_change.start_s
+}
+
+#[test]
+fn the_start_seen_in_the_lessons_is_the_users() {
+    for style in StylePreset::ALL {
+        let config = config("collector-high", 40.0, style);
+        let result = run(&config, None, &mut NoObserver).expect("the run completes");
+        let onset = (result.experience.onsets.last()).expect("a takeover shows the user's start");
+        let truth = true_start_s(&config);
+        assert!(
+            (onset.time_s - truth).abs() < 0.05,
+            "{style:?}: observed {} s, the user starts at {truth} s",
+            onset.time_s
+        );
+        assert_eq!(result.experience.anchor_s, Some(onset.time_s));
+    }
+}
+
+#[test]
+fn a_carried_experience_starts_where_the_new_scene_puts_the_user() {
+    // Same headway user, closing speed doubled: the time from the plan's start to
+    // the user's start halves, which a time-indexed experience cannot know.
+    for style in StylePreset::ALL {
+        let source = config("collector-high", 50.0, style);
+        let learned = run(&source, None, &mut NoObserver).expect("the source run completes");
+        let target = config("collector-slow", 50.0, style);
+        let carried = LearningLoop::new(&target, Some(&learned.experience))
+            .expect("the target scenario prepares");
+        let anchor = carried.experience().anchor_s.expect("the start is predicted");
+        let truth = true_start_s(&target);
+        assert!(
+            (anchor - truth).abs() <= target.planning.dt + 1e-9,
+            "{style:?}: predicted {anchor} s, the user starts at {truth} s"
+        );
+    }
+}
+
+#[test]
+fn relative_onset_transfers_better_than_time_indexing() {
+    let style = StylePreset::Neutral;
+    let source = config("collector-slow", 50.0, style);
+    let learned = run(&source, None, &mut NoObserver).expect("the source run completes");
+    let target = config("collector-high", 50.0, style);
+    let takeovers = |representation| {
+        let config = with_representation(&target, representation);
+        run(&config, Some(&learned.experience), &mut NoObserver)
+            .expect("the transfer run completes")
+            .summary
+            .counted_takeovers()
+    };
+    let scratch = run(&target, None, &mut NoObserver)
+        .expect("the scratch run completes")
+        .summary
+        .counted_takeovers();
+    let (relative, time_indexed) = (
+        takeovers(Representation::RelativeOnset),
+        takeovers(Representation::TimeIndexed),
+    );
+    assert!(
+        relative < time_indexed && relative <= scratch,
+        "relative onset {relative}, time-indexed {time_indexed}, from scratch {scratch}"
+    );
+}
