@@ -9,7 +9,7 @@ use crate::claims::{num, pct};
 use crate::config::UserKind;
 use crate::results::RunRow;
 use crate::stats::{self, Summary};
-use crate::views::grid;
+use crate::views::{grid, with_transfer};
 
 /// Share of counted runs that must personalize for a family to count as learned.
 pub const FAMILY_SUCCESS_TARGET: f64 = 0.95;
@@ -27,7 +27,7 @@ fn rules(kind: &UserKind) -> String {
 }
 
 /// Writes the section; nothing when `kinds` is empty.
-pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method], kinds: &[UserKind]) {
+pub fn section(out: &mut String, all: &[RunRow], methods: &[Method], kinds: &[UserKind]) {
     if kinds.is_empty() {
         return;
     }
@@ -41,20 +41,22 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method], kinds: &[U
          learned when at least {:.0} % of its counted runs personalize; refused runs (a user without \
          a sane lane change in the scene, named in the refusals section) are not counted. For users \
          with spread, the final takeover rate over the last window is shown against the ceiling (the \
-         rate of the user's own nominal lane change on the same draws).\n",
+         rate of the user's own nominal lane change on the same draws). The transfer column pairs each \
+         `[transfer]` run of the kind with the same cell learned from scratch: mean takeovers without \
+         and with the experience of the other scene, and the reduction.\n",
         FAMILY_SUCCESS_TARGET * 100.0
     );
     let _ = writeln!(
         out,
-        "| user kind | rules | method | runs | refused | personalized | mean takeovers | max takeovers | final max deviation (m) | final takeover rate vs ceiling | perceived-safety takeovers | verdict |"
+        "| user kind | rules | method | runs | refused | personalized | mean takeovers | max takeovers | final max deviation (m) | final takeover rate vs ceiling | perceived-safety takeovers | transfer: scratch -> with experience | verdict |"
     );
     let _ = writeln!(
         out,
-        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
+        "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
     );
     for kind in kinds {
         for &method in methods {
-            let rows = grid(rows, method, &kind.name);
+            let rows = grid(all, method, &kind.name);
             let summary = Summary::of(rows.iter().copied());
             let counted: Vec<&RunRow> = rows
                 .iter()
@@ -83,6 +85,20 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method], kinds: &[U
                 .flat_map(|r| &r.iterations)
                 .filter(|i| i.perceived_safety_takeover)
                 .count();
+            let transfer = stats::transfer(&with_transfer(all, method, &kind.name));
+            let transfer = if transfer.pairs == 0 {
+                "-".to_owned()
+            } else {
+                format!(
+                    "{} -> {} ({}, {} cells)",
+                    num(transfer.without, 2),
+                    num(transfer.with, 2),
+                    transfer
+                        .reduction
+                        .map_or_else(|| "n/a".to_owned(), |r| format!("{:+.0} %", -100.0 * r)),
+                    transfer.pairs
+                )
+            };
             let verdict = match summary.success_rate() {
                 None => "no run counted".to_owned(),
                 Some(rate) if rate >= FAMILY_SUCCESS_TARGET => "learned".to_owned(),
@@ -94,7 +110,7 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method], kinds: &[U
             };
             let _ = writeln!(
                 out,
-                "| {} | {} | `{}` | {} | {} | {} | {} | {} | {} | {} | {perceived} of {takeovers} | {verdict} |",
+                "| {} | {} | `{}` | {} | {} | {} | {} | {} | {} | {} | {perceived} of {takeovers} | {transfer} | {verdict} |",
                 kind.name,
                 rules(kind),
                 method.name(),

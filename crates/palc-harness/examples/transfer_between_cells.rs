@@ -13,7 +13,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "/../../configs/learn.toml"
     ))?;
     let base = LearnConfig::from_toml_str(&text)?;
-    let testbed = base.traffic.testbed.clone().ok_or("learn.toml has a test bed")?;
+    let testbed = base
+        .traffic
+        .testbed
+        .clone()
+        .ok_or("learn.toml has a test bed")?;
     let cases: Vec<String> = testbed.speed_cases.iter().map(|c| c.name.clone()).collect();
     let headways = testbed.adjacent_headways_m.clone();
     let by_headway = std::env::args().nth(1).is_some_and(|a| a == "headway");

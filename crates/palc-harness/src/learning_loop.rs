@@ -422,8 +422,9 @@ impl LearningLoop {
     /// becomes the anchor of the weights.
     fn observe_onset(&mut self, drive: &Drive, takeover_step: usize) {
         let driven_l: Vec<f64> = drive.driven.iter().map(|x| x.l).collect();
-        let observed = observed_start_s(&driven_l, takeover_step, self.setup.dt, self.setup.target_l)
-            .and_then(|start| onset_at(&self.setup, start));
+        let observed =
+            observed_start_s(&driven_l, takeover_step, self.setup.dt, self.setup.target_l)
+                .and_then(|start| onset_at(&self.setup, start));
         let Some(observed) = observed else { return };
         let onsets = &mut self.experience.onsets;
         let merged = match onsets.last() {

@@ -99,7 +99,11 @@ pub(crate) fn observed_start_s(
 /// control steps. At least 1, so that a step before it exists.
 fn start_step(setup: &Setup, start_s: f64) -> Option<usize> {
     let last = setup.situations.len().checked_sub(1)?;
-    Some(((start_s / setup.dt).round() as usize).clamp(1, last.max(1)).min(last))
+    Some(
+        ((start_s / setup.dt).round() as usize)
+            .clamp(1, last.max(1))
+            .min(last),
+    )
 }
 
 /// The threshold of a feature revealed by a start at step `step`: the midpoint

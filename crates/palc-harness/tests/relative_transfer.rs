@@ -59,7 +59,10 @@ fn a_carried_experience_starts_where_the_new_scene_puts_the_user() {
         let target = config("collector-slow", 50.0, style);
         let carried = LearningLoop::new(&target, Some(&learned.experience))
             .expect("the target scenario prepares");
-        let anchor = carried.experience().anchor_s.expect("the start is predicted");
+        let anchor = carried
+            .experience()
+            .anchor_s
+            .expect("the start is predicted");
         let truth = true_start_s(&target);
         assert!(
             (anchor - truth).abs() <= target.planning.dt + 1e-9,
