@@ -10,9 +10,10 @@
 //!    [`palc_planner::Planner`] with its tracking term: [`ZoneCentreExpert`] (the paper,
 //!    Eqs. 24-26) or [`LessonExpert`] (the executed trajectory, re-planned);
 //! 3. a [`RewardCorrection`] rule returns one new weight matrix:
-//!    [`ApprenticeshipRule`] (Abbeel & Ng's projection method, Eqs. 33-36) or
-//!    [`IncrementalRule`] (projected steps from the current weights with
-//!    backtracking), changing only the [`LearnableRows`];
+//!    [`ApprenticeshipRule`] (Abbeel & Ng's projection method, Eqs. 33-36),
+//!    [`IncrementalRule`] (projected feature-matching steps from the current
+//!    weights with backtracking) or [`TargetRule`] (iterative learning of each
+//!    stage's lateral target, the default), changing only the [`LearnableRows`];
 //! 4. the next lane change is planned with the new weights.
 //!
 //! Sign convention: the planner *minimizes* the cost `J = w · Φ(ψ)` (Eq. 15); every
@@ -54,7 +55,7 @@
 //! let lesson = Lesson { planned, executed, takeover_step, samples: vec![], step_scenes: vec![] };
 //!
 //! let experience = Experience::new("user-1", "45-40mph", "palc", standard, 0.2)?;
-//! let options = AggregatorOptions::default(); // lesson expert, incremental rule on w1, w2
+//! let options = AggregatorOptions::default(); // lesson expert, target rule on w1, w2
 //! let outcome = learn_from_lesson(&mut planner, &experience, &lesson, &template, &options)?;
 //! assert_eq!(outcome.experience.metadata.lessons, 1);
 //! let (before, after) = (outcome.correction.error_before.unwrap(), outcome.correction.error_after.unwrap());
@@ -86,7 +87,7 @@ pub mod advanced {
 }
 pub use correction::{
     ApprenticeshipRule, ApprenticeshipState, CorrectionInput, CorrectionOutcome, CorrectionRule,
-    IncrementalRule, RewardCorrection,
+    IncrementalRule, RewardCorrection, TargetRule,
 };
 pub use error::AggregatorError;
 pub use experience::{EXPERIENCE_FORMAT_VERSION, Experience, ExperienceMetadata};

@@ -10,10 +10,12 @@ use crate::{
 
 /// How the aggregator learns from a lesson. Maps one to one onto a TOML table.
 ///
-/// The defaults are the repaired method that personalized 60 / 60 grid cases in an
-/// independent prototype: the lesson expert, the incremental rule on rows `w1`, `w2`,
-/// no zone (a zone on top personalized only 35 / 60 there; it has to earn its place
-/// by measurement). [`AggregatorOptions::paper`] gives the paper's method.
+/// The defaults are `palc`'s method: the lesson expert, the target rule
+/// ([`crate::TargetRule`]) on rows `w1`, `w2`, no zone (a zone on top personalized
+/// only 35 / 60 grid cases in an independent prototype; it has to earn its place by
+/// measurement), experience anchored at the user's start
+/// ([`Representation::RelativeOnset`]). [`AggregatorOptions::paper`] gives the
+/// paper's method.
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct AggregatorOptions {
@@ -73,8 +75,17 @@ impl AggregatorOptions {
     pub fn validate(&self) -> Result<(), AggregatorError> {
         self.feature_scale.validate()?;
         self.convex_set.validate()?;
-        if let CorrectionRule::Incremental(rule) = &self.correction {
-            rule.validate()?;
+        match &self.correction {
+            CorrectionRule::Incremental(rule) => rule.validate()?,
+            CorrectionRule::Target(rule) => {
+                rule.validate()?;
+                if !self.learnable_rows.contains(palc_planner::feature::L) {
+                    return Err(AggregatorError::ConflictingOptions {
+                        reason: "the target rule moves w2: learnable_rows must include row 1 (l)",
+                    });
+                }
+            }
+            CorrectionRule::Apprenticeship(_) => {}
         }
         if matches!(self.expert, ExpertKind::ZoneCentre(_)) && !self.use_zone {
             return Err(AggregatorError::ConflictingOptions {

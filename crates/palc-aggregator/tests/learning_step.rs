@@ -5,7 +5,7 @@ mod common;
 
 use palc_aggregator::{
     AggregatorOptions, ApprenticeshipRule, CorrectionRule, Experience, ExpertKind, IncrementalRule,
-    LearnableRows, LessonExpert, ZoneCentreExpert, feature_error, learn_from_lesson,
+    LearnableRows, LessonExpert, TargetRule, ZoneCentreExpert, feature_error, learn_from_lesson,
 };
 use palc_planner::{FEATURE_COUNT, Planner, Problem, Weights, check_convexity};
 use proptest::prelude::*;
@@ -28,12 +28,26 @@ fn rule_strategy() -> impl Strategy<Value = CorrectionRule> {
                 min_step_size: 1e-3 * step_size,
             })
         }),
+        (0.1f64..=1.0, 1usize..8).prop_map(|(gain, max_inner_solves)| {
+            CorrectionRule::Target(TargetRule {
+                gain,
+                max_inner_solves,
+                tolerance_m: 0.005,
+            })
+        }),
     ]
 }
 
 /// Options: any rule and rows; the zone-centre expert only with the zone.
 fn options_strategy() -> impl Strategy<Value = AggregatorOptions> {
     (rule_strategy(), rows_strategy(), any::<bool>()).prop_map(|(correction, rows, zone)| {
+        // The target rule moves w2: it needs row 1.
+        let rows = match correction {
+            CorrectionRule::Target(_) => {
+                LearnableRows::from_indices(rows.indices().chain(std::iter::once(1)))
+            }
+            _ => rows,
+        };
         AggregatorOptions {
             expert: if zone {
                 ExpertKind::ZoneCentre(ZoneCentreExpert::default())
@@ -170,6 +184,46 @@ proptest! {
         prop_assert!(new_error <= previous_error + 1e-7 * (1.0 + previous_error),
             "new {new_error} > previous {previous_error}");
         prop_assert!((new_error - after).abs() <= 1e-7 * (1.0 + after));
+    }
+
+    /// With the target rule, the new plan's lateral path is never further from the
+    /// expert's (root mean square) than the plan with the previous weights, the
+    /// weights stay convex, and only row `w2` changes.
+    #[test]
+    fn the_target_rule_never_moves_the_plan_away_from_the_expert(
+        horizon in 20usize..=32,
+        takeover_fraction in 0.05f64..0.8,
+        pull in 0.05f64..1.5,
+        gain in 0.1f64..=1.0,
+        prior in prior_strategy(32),
+    ) {
+        let mut c = case(horizon, prior);
+        let options = AggregatorOptions {
+            correction: CorrectionRule::Target(TargetRule { gain, ..TargetRule::default() }),
+            ..AggregatorOptions::default()
+        };
+        let (problem, _) = palc_aggregator::plan_problem(
+            &c.planner, &c.experience, &c.template, &[], &options,
+        ).unwrap();
+        let takeover = ((horizon as f64 * takeover_fraction) as usize).max(1);
+        let lesson = common::lesson(&mut c.planner, &problem, takeover, pull);
+        let outcome = learn_from_lesson(
+            &mut c.planner, &c.experience, &lesson, &c.template, &options,
+        ).unwrap();
+        let lateral = |plan: &palc_planner::Plan| {
+            let n = plan.states.len() - 1;
+            let sum: f64 = (0..n)
+                .map(|i| (plan.states[i].l - outcome.expert.states[i].l).powi(2))
+                .sum();
+            (sum / n as f64).sqrt()
+        };
+        let previous = c.planner.plan(&problem).unwrap();
+        prop_assert!(lateral(&outcome.plan) <= lateral(&previous) + 1e-9,
+            "new {} > previous {}", lateral(&outcome.plan), lateral(&previous));
+        prop_assert!(check_convexity(&outcome.experience.weights).is_ok());
+        for j in (0..FEATURE_COUNT).filter(|&j| j != 1) {
+            prop_assert!(outcome.experience.weights.row(j).eq(problem.weights.row(j)), "row {j} changed");
+        }
     }
 
     /// The lesson expert satisfies the planner's dynamics and stays within 0.05 m of

@@ -474,12 +474,20 @@ fn starting_experience(
     options: &AggregatorOptions,
 ) -> Result<Experience, HarnessError> {
     let (k, dt) = (setup.horizon, setup.dt);
+    let standard = || {
+        let lane_change = setup.standard_lane_change(&config.planning.standard_alc);
+        config.standard_weights.weights(&lane_change, k, dt)
+    };
     match previous {
         Some(previous) => {
             let mut carried = previous.clone();
             let anchored = match (options.representation, previous.anchor_s) {
                 (Representation::RelativeOnset, Some(anchor)) => {
-                    predicted_start_s(setup, &previous.onsets).map(|start| (anchor, start))
+                    // No user starts after the standard ALC (the scenario's premise,
+                    // checked in `prepare`): a later prediction is held there.
+                    let latest = setup.standard_start_step as f64 * dt;
+                    predicted_start_s(setup, &previous.onsets)
+                        .map(|start| (anchor, start.min(latest)))
                 }
                 _ => None,
             };
@@ -500,17 +508,13 @@ fn starting_experience(
             carried.metadata.scenario = config.label();
             Ok(carried)
         }
-        None => {
-            let standard = setup.standard_lane_change(&config.planning.standard_alc);
-            let weights = config.standard_weights.weights(&standard, k, dt);
-            Ok(Experience::new(
-                config.user.style.name(),
-                config.label(),
-                config.method.name(),
-                weights,
-                dt,
-            )?)
-        }
+        None => Ok(Experience::new(
+            config.user.style.name(),
+            config.label(),
+            config.method.name(),
+            standard(),
+            dt,
+        )?),
     }
 }
 

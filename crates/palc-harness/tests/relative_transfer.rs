@@ -73,27 +73,32 @@ fn a_carried_experience_starts_where_the_new_scene_puts_the_user() {
 
 #[test]
 fn relative_onset_transfers_better_than_time_indexing() {
-    let style = StylePreset::Neutral;
-    let source = config("collector-slow", 50.0, style);
-    let learned = run(&source, None, &mut NoObserver).expect("the source run completes");
-    let target = config("collector-high", 50.0, style);
-    let takeovers = |representation| {
-        let config = with_representation(&target, representation);
-        run(&config, Some(&learned.experience), &mut NoObserver)
-            .expect("the transfer run completes")
+    let (mut relative_sum, mut time_indexed_sum) = (0, 0);
+    for style in StylePreset::ALL {
+        let source = config("collector-slow", 40.0, style);
+        let learned = run(&source, None, &mut NoObserver).expect("the source run completes");
+        let target = config("collector-high", 40.0, style);
+        let takeovers = |representation| {
+            let config = with_representation(&target, representation);
+            run(&config, Some(&learned.experience), &mut NoObserver)
+                .expect("the transfer run completes")
+                .summary
+                .counted_takeovers()
+        };
+        let scratch = run(&target, None, &mut NoObserver)
+            .expect("the scratch run completes")
             .summary
-            .counted_takeovers()
-    };
-    let scratch = run(&target, None, &mut NoObserver)
-        .expect("the scratch run completes")
-        .summary
-        .counted_takeovers();
-    let (relative, time_indexed) = (
-        takeovers(Representation::RelativeOnset),
-        takeovers(Representation::TimeIndexed),
-    );
+            .counted_takeovers();
+        let relative = takeovers(Representation::RelativeOnset);
+        assert!(
+            relative <= scratch,
+            "{style:?}: relative onset {relative}, from scratch {scratch}"
+        );
+        relative_sum += relative;
+        time_indexed_sum += takeovers(Representation::TimeIndexed);
+    }
     assert!(
-        relative < time_indexed && relative <= scratch,
-        "relative onset {relative}, time-indexed {time_indexed}, from scratch {scratch}"
+        relative_sum < time_indexed_sum,
+        "relative onset {relative_sum}, time-indexed {time_indexed_sum} (three styles)"
     );
 }

@@ -7,9 +7,11 @@
 
 mod apprenticeship;
 mod incremental;
+mod target;
 
 pub use apprenticeship::{ApprenticeshipRule, ApprenticeshipState};
 pub use incremental::IncrementalRule;
+pub use target::TargetRule;
 
 use palc_planner::{Features, Plan, PlanError, Weights};
 use serde::{Deserialize, Serialize};
@@ -73,13 +75,15 @@ pub trait RewardCorrection {
 pub enum CorrectionRule {
     /// [`ApprenticeshipRule`] (the paper, Eqs. 33-36).
     Apprenticeship(ApprenticeshipRule),
-    /// [`IncrementalRule`] (the default).
+    /// [`IncrementalRule`]: projected feature-matching steps.
     Incremental(IncrementalRule),
+    /// [`TargetRule`] (the default): iterative learning of the lateral targets.
+    Target(TargetRule),
 }
 
 impl Default for CorrectionRule {
     fn default() -> Self {
-        CorrectionRule::Incremental(IncrementalRule::default())
+        CorrectionRule::Target(TargetRule::default())
     }
 }
 
@@ -89,6 +93,7 @@ impl CorrectionRule {
         match self {
             CorrectionRule::Apprenticeship(r) => r,
             CorrectionRule::Incremental(r) => r,
+            CorrectionRule::Target(r) => r,
         }
     }
 }
