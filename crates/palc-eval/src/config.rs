@@ -155,6 +155,16 @@ pub struct TransferConfig {
     pub source: TransferSource,
     /// Names of the user kinds to run it for.
     pub users: Vec<String>,
+    /// User kinds for which every grid cell is run again from the experience of
+    /// every other speed case (same headway) and every other headway (same speed
+    /// case): the transfer matrix. Default none.
+    #[serde(default)]
+    pub matrix_users: Vec<String>,
+    /// User kinds who drive the grid's speed cases in sequence (and, separately,
+    /// its headways), each scene started from the experience of the one before.
+    /// Default none.
+    #[serde(default)]
+    pub accumulation_users: Vec<String>,
 }
 
 /// Compute time against the step `dt` and the horizon `K`.
@@ -268,11 +278,16 @@ impl EvalConfig {
         let users = (self.quick.users.iter())
             .map(|name| self.user(name, "quick.users").cloned())
             .collect::<Result<Vec<_>, _>>()?;
-        let transfer = TransferConfig {
-            users: (self.transfer.users.iter())
+        let quick = |names: &[String]| -> Vec<String> {
+            (names.iter())
                 .filter(|name| self.quick.users.contains(name))
                 .cloned()
-                .collect(),
+                .collect()
+        };
+        let transfer = TransferConfig {
+            users: quick(&self.transfer.users),
+            matrix_users: quick(&self.transfer.matrix_users),
+            accumulation_users: quick(&self.transfer.accumulation_users),
             ..self.transfer.clone()
         };
         Ok(Selection {
@@ -336,8 +351,17 @@ impl EvalConfig {
                 ));
             }
         }
-        for name in &self.transfer.users {
-            self.user(name, "transfer.users")?;
+        for (field, names) in [
+            ("transfer.users", &self.transfer.users),
+            ("transfer.matrix_users", &self.transfer.matrix_users),
+            (
+                "transfer.accumulation_users",
+                &self.transfer.accumulation_users,
+            ),
+        ] {
+            for name in names {
+                self.user(name, field)?;
+            }
         }
         for name in &self.quick.users {
             self.user(name, "quick.users")?;

@@ -47,6 +47,7 @@ pub mod results;
 pub mod runner;
 pub mod safety_report;
 pub mod stats;
+pub mod transfer_report;
 pub mod views;
 
 use std::path::{Path, PathBuf};

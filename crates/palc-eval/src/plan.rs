@@ -22,6 +22,12 @@ pub enum Experiment {
     Timing,
     /// A grid cell driven in closed loop (`[planning.closed_loop]` on).
     ClosedLoop,
+    /// A grid cell started with experience from one other speed case or headway
+    /// of the grid (`transfer.matrix_users`): every ordered pair.
+    Matrix,
+    /// A scene of a sequence one user drives, each started with the experience
+    /// of the scene before (`transfer.accumulation_users`).
+    Accumulation,
 }
 
 impl Experiment {
@@ -32,6 +38,8 @@ impl Experiment {
             Experiment::Transfer => "transfer",
             Experiment::Timing => "timing",
             Experiment::ClosedLoop => "closed-loop",
+            Experiment::Matrix => "transfer-matrix",
+            Experiment::Accumulation => "accumulation",
         }
     }
 }
@@ -103,13 +111,15 @@ impl RunSpec {
 }
 
 /// The runs of a selection, in two phases: runs without experience first (grid,
-/// timing, closed loop), then
-/// the transfer runs, which need the experience of phase-one runs.
+/// timing, closed loop), then the runs that start from experience (transfer,
+/// transfer matrix, accumulation), which the runner starts as soon as the run
+/// they learn from has ended.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RunPlan {
     /// Grid and timing runs.
     pub first: Vec<RunSpec>,
-    /// Transfer runs; `experience_from` points into `first`.
+    /// Runs with experience; `experience_from` points into `first` or to an
+    /// earlier run of this list (accumulation).
     pub transfer: Vec<RunSpec>,
 }
 
@@ -210,6 +220,88 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
             ..target.clone()
         });
     }
+    let grid_runs: Vec<RunSpec> = (first.iter())
+        .filter(|s| s.experiment == Experiment::Grid)
+        .cloned()
+        .collect();
+    let same = |a: &RunSpec, b: &RunSpec| {
+        a.method == b.method && a.user == b.user && a.style == b.style && a.seed == b.seed
+    };
+    let id = |first: &[RunSpec], transfer: &[RunSpec]| first.len() + transfer.len();
+    // Transfer matrix: every ordered pair of speed cases (same headway), then of
+    // headways (same speed case).
+    for target in grid_runs
+        .iter()
+        .filter(|s| selection.transfer.matrix_users.contains(&s.user.name))
+    {
+        let sources = grid_runs.iter().filter(|s| {
+            same(s, target)
+                && ((s.headway_m == target.headway_m
+                    && s.speed_case.name != target.speed_case.name)
+                    || (s.speed_case.name == target.speed_case.name
+                        && s.headway_m != target.headway_m))
+        });
+        for source in sources {
+            transfer.push(RunSpec {
+                id: id(&first, &transfer),
+                experiment: Experiment::Matrix,
+                experience_from: Some(source.id),
+                ..target.clone()
+            });
+        }
+    }
+    // Accumulation: each chain starts at the grid run of the grid's first speed
+    // case (first headway) and goes through the others in grid order.
+    for start in grid_runs
+        .iter()
+        .filter(|s| selection.transfer.accumulation_users.contains(&s.user.name))
+    {
+        let first_case = grid.speed_cases.first().map(|c| c.name.as_str());
+        let first_headway = grid.headways_m.first().copied();
+        let chains: [Vec<RunSpec>; 2] = [
+            if Some(start.speed_case.name.as_str()) == first_case {
+                (grid.speed_cases.iter().skip(1))
+                    .filter_map(|case| {
+                        grid_runs.iter().find(|s| {
+                            same(s, start)
+                                && s.headway_m == start.headway_m
+                                && s.speed_case.name == case.name
+                        })
+                    })
+                    .cloned()
+                    .collect()
+            } else {
+                Vec::new()
+            },
+            if Some(start.headway_m) == first_headway {
+                (grid.headways_m.iter().skip(1))
+                    .filter_map(|&headway| {
+                        grid_runs.iter().find(|s| {
+                            same(s, start)
+                                && s.speed_case.name == start.speed_case.name
+                                && s.headway_m == headway
+                        })
+                    })
+                    .cloned()
+                    .collect()
+            } else {
+                Vec::new()
+            },
+        ];
+        for chain in chains {
+            let mut previous = start.id;
+            for scene in chain {
+                let next = id(&first, &transfer);
+                transfer.push(RunSpec {
+                    id: next,
+                    experiment: Experiment::Accumulation,
+                    experience_from: Some(previous),
+                    ..scene
+                });
+                previous = next;
+            }
+        }
+    }
     Ok(RunPlan { first, transfer })
 }
 
@@ -302,6 +394,8 @@ pub(crate) mod tests {
             transfer: TransferConfig {
                 source: TransferSource::NextSpeedCase,
                 users: vec!["deterministic".into()],
+                matrix_users: Vec::new(),
+                accumulation_users: Vec::new(),
             },
             closed_loop: ClosedLoopRuns::default(),
             timing: TimingConfig {
@@ -369,6 +463,63 @@ pub(crate) mod tests {
             );
             assert_ne!(source.speed_case, target.speed_case);
         }
+    }
+
+    #[test]
+    fn the_matrix_pairs_every_other_scene_and_accumulation_chains_follow_the_grid() {
+        let mut selection = selection();
+        selection.grid.speed_cases = testbed().speed_cases[..3].to_vec();
+        selection.transfer.users.clear();
+        selection.transfer.matrix_users = vec!["deterministic".into()];
+        selection.transfer.accumulation_users = vec!["deterministic".into()];
+        let plan = expand(&selection, &testbed()).unwrap();
+        assert!(plan.all().enumerate().all(|(i, s)| s.id == i));
+        let cells = (plan.first.iter())
+            .filter(|s| s.experiment == Experiment::Grid && s.user.name == "deterministic")
+            .count();
+        let same_run = |a: &RunSpec, b: &RunSpec| {
+            (a.method, &a.user, a.style, a.seed) == (b.method, &b.user, b.style, b.seed)
+        };
+        // Every cell from each of the 2 other speed cases and the 1 other headway.
+        let matrix: Vec<&RunSpec> = (plan.transfer.iter())
+            .filter(|s| s.experiment == Experiment::Matrix)
+            .collect();
+        assert_eq!(matrix.len(), cells * 3);
+        for target in matrix {
+            let source = &plan.first[target.experience_from.unwrap()];
+            assert_eq!(source.experiment, Experiment::Grid);
+            assert!(same_run(source, target));
+            let case = source.speed_case.name != target.speed_case.name;
+            let headway = source.headway_m != target.headway_m;
+            assert!(
+                case != headway,
+                "{} from {}",
+                target.label(),
+                source.label()
+            );
+        }
+        // Chains: 2 speed cases after the first, per headway; 1 headway after the
+        // first, per speed case; each scene from the one before it.
+        let chained: Vec<&RunSpec> = (plan.transfer.iter())
+            .filter(|s| s.experiment == Experiment::Accumulation)
+            .collect();
+        let starts_per_axis = cells / (3 * 2);
+        assert_eq!(chained.len(), starts_per_axis * 2 * 2 + starts_per_axis * 3);
+        for scene in &chained {
+            let from = scene.experience_from.unwrap();
+            assert!(from < scene.id);
+            let source = plan.all().find(|s| s.id == from).unwrap();
+            assert!(same_run(source, scene));
+            assert!(matches!(
+                source.experiment,
+                Experiment::Grid | Experiment::Accumulation
+            ));
+        }
+        assert!((chained.iter()).any(|s| {
+            plan.transfer.iter().any(|t| {
+                Some(t.id) == s.experience_from && t.experiment == Experiment::Accumulation
+            })
+        }));
     }
 
     #[test]

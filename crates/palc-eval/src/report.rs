@@ -63,6 +63,7 @@ pub fn render(input: &ReportInput) -> String {
         user_section(&mut out, input, user);
     }
     crate::families_report::section(&mut out, input.rows, input.methods, input.user_kinds);
+    crate::transfer_report::section(&mut out, input.rows, input.methods);
     claims_section(&mut out);
     crate::safety_report::section(&mut out, input.rows, input.methods);
     crate::closed_loop_report::section(&mut out, input.rows, input.methods, input.users);

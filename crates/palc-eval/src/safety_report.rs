@@ -37,6 +37,8 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
         Experiment::Transfer,
         Experiment::Timing,
         Experiment::ClosedLoop,
+        Experiment::Matrix,
+        Experiment::Accumulation,
     ] {
         for &method in methods {
             let iterations: Vec<&Iteration> = rows

@@ -57,6 +57,8 @@ fn subset(evaluation: &Evaluation) -> Selection {
     selection.transfer = TransferConfig {
         source: TransferSource::NextSpeedCase,
         users: selection.users.iter().map(|u| u.name.clone()).collect(),
+        matrix_users: Vec::new(),
+        accumulation_users: Vec::new(),
     };
     selection.closed_loop = Default::default();
     selection.timing = TimingConfig {
