@@ -32,7 +32,8 @@ pub struct ExperienceMetadata {
 /// matrix, the apprenticeship state, the user's observed starts and metadata.
 ///
 /// Saved as JSON `{format_version, metadata, weights, zone, apprenticeship,
-/// anchor_s, onsets}` (the last two may be absent in older files); the
+/// anchor_s, onsets, demonstration}` (the last three may be absent in older
+/// files); the
 /// zone is the zone filter's own versioned serialization. Numbers round-trip
 /// bit-exactly (shortest representation on write, correctly rounded parse).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -53,6 +54,10 @@ pub struct Experience {
     pub anchor_s: Option<f64>,
     /// The user's observed starts, one per scene learned in, oldest first.
     pub onsets: Vec<Onset>,
+    /// The lateral path (m) of the last lesson's expert, at steps `0..=K` of the
+    /// weights' time base (step `metadata.dt`): what the user was seen to drive,
+    /// which a new scene can rehearse. `None` before the first lesson.
+    pub demonstration: Option<Vec<f64>>,
 }
 
 /// The file layout: the version first, so that a reader sees it before anything else.
@@ -68,6 +73,8 @@ struct Stored {
     anchor_s: Option<f64>,
     #[serde(default)]
     onsets: Vec<Onset>,
+    #[serde(default)]
+    demonstration: Option<Vec<f64>>,
 }
 
 #[derive(Deserialize)]
@@ -101,6 +108,7 @@ impl Experience {
             apprenticeship: None,
             anchor_s: None,
             onsets: Vec::new(),
+            demonstration: None,
         };
         experience.validate()?;
         Ok(experience)
@@ -136,6 +144,14 @@ impl Experience {
         }
         for (i, onset) in self.onsets.iter().enumerate() {
             onset.validate(i)?;
+        }
+        for (i, &l) in self.demonstration.iter().flatten().enumerate() {
+            if !l.is_finite() {
+                return Err(AggregatorError::NonFinite {
+                    field: format!("demonstration[{i}]"),
+                    value: l,
+                });
+            }
         }
         let matrices = std::iter::once(("weights", self.weights.columns())).chain(
             self.apprenticeship
@@ -176,6 +192,7 @@ impl Experience {
             apprenticeship: self.apprenticeship.clone(),
             anchor_s: self.anchor_s,
             onsets: self.onsets.clone(),
+            demonstration: self.demonstration.clone(),
         };
         let mut bytes =
             serde_json::to_vec_pretty(&stored).map_err(|e| AggregatorError::Serialize {
@@ -230,6 +247,7 @@ impl Experience {
             apprenticeship: stored.apprenticeship,
             anchor_s: stored.anchor_s,
             onsets: stored.onsets,
+            demonstration: stored.demonstration,
         };
         experience.validate().map_err(|e| corrupt(e.to_string()))?;
         Ok(experience)

@@ -218,6 +218,7 @@ pub fn learn_from_lesson(
             apprenticeship: outcome.apprenticeship,
             anchor_s: experience.anchor_s,
             onsets: experience.onsets.clone(),
+            demonstration: Some(expert.states.iter().map(|x| x.l).collect()),
         },
         expert,
         plan,

@@ -60,6 +60,7 @@ fn sample_experience() -> Experience {
         lag_time_gap_s: Some(0.031),
         observations: 2,
     }];
+    experience.demonstration = Some((0..=20).map(|i| 3.5 * f64::from(i) / 20.0).collect());
     experience
 }
 
@@ -243,10 +244,12 @@ fn a_file_without_onsets_loads_with_none() {
     let object = json.as_object_mut().unwrap();
     object.remove("anchor_s");
     object.remove("onsets");
+    object.remove("demonstration");
     fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
     let loaded = Experience::load(&path).unwrap();
     experience.anchor_s = None;
     experience.onsets.clear();
+    experience.demonstration = None;
     assert_eq!(loaded, experience);
 }
 

@@ -8,11 +8,12 @@ use std::time::Instant;
 
 use palc_aggregator::{
     AggregatorError, AggregatorOptions, Experience, Representation, StepOutcome, Timings,
-    learn_from_lesson, plan_problem, resample_weights_shifted,
+    learn_from_lesson, plan_problem,
 };
 use palc_planner::{LateralBoundsMode, Plan, Planner, PlannerConfig, Problem};
 
 use crate::HarnessError;
+use crate::carry::{rehearse, starting_experience};
 use crate::closed_loop::ClosedLoop;
 use crate::config::{LearnConfig, StoppingConfig};
 use crate::drive::{Drive, execute, judge, plan_safety, problem};
@@ -20,7 +21,7 @@ use crate::learn::{RunResult, aggregator_options, prepare_for};
 use crate::lesson::{lesson, scenes, zone_feature_set};
 use crate::method::Method;
 use crate::observer::{LessonEvent, Observer};
-use crate::onset::{observed_start_s, onset_at, predicted_start_s};
+use crate::onset::{observed_start_s, onset_at, user_path};
 use crate::record::{LaneChangeRecord, Outcome, RunSummary};
 use crate::safety::{SafetyMetrics, Violation};
 use crate::setup::Setup;
@@ -124,7 +125,7 @@ impl LearningLoop {
         }
         let options = aggregator_options(config);
         options.validate()?;
-        let experience = starting_experience(config, &setup, experience, &options)?;
+        let (experience, rehearsal) = starting_experience(config, &setup, experience, &options)?;
         let mut planner = Planner::new(PlannerConfig {
             horizon: setup.horizon,
             dt: setup.dt,
@@ -155,6 +156,10 @@ impl LearningLoop {
             None
         };
         let template = problem(&setup, experience.weights.clone(), Vec::new());
+        let experience = match rehearsal {
+            Some(path) => rehearse(&mut planner, &setup, &template, experience, &path, &options),
+            None => experience,
+        };
         let (first_problem, _) = plan_problem(
             &planner,
             &experience,
@@ -381,7 +386,18 @@ impl LearningLoop {
     ) -> Result<(), HarnessError> {
         // The samples update the zone, so they take its features (Eq. 1 or a variant).
         let feature_set = zone_feature_set(&self.experience, &self.options);
-        let lesson = lesson(self.method, &self.setup, drive, takeover_step, feature_set)?;
+        let mut lesson = lesson(self.method, &self.setup, drive, takeover_step, feature_set)?;
+        if self.options.representation == Representation::RelativeOnset {
+            // The expert follows the user's whole path: before the takeover, the
+            // quintic fitted to what the user drove after it, not the old plan.
+            let driven_l: Vec<f64> = drive.driven.iter().map(|x| x.l).collect();
+            let (dt, target_l) = (self.setup.dt, self.setup.target_l);
+            if let Some(path) = user_path(&driven_l, takeover_step, dt, target_l) {
+                for (state, l) in lesson.executed.iter_mut().zip(path) {
+                    state.l = l;
+                }
+            }
+        }
         let result: Result<StepOutcome, AggregatorError> = learn_from_lesson(
             &mut self.planner,
             &self.experience,
@@ -456,65 +472,6 @@ impl LearningLoop {
             final_takeover_rate: rate(|r| r.takeover.is_some()),
             ceiling_takeover_rate: rate(|r| r.nominal_plan_taken_over),
         }
-    }
-}
-
-/// The experience a run starts from: `previous` carried into this scenario, or a
-/// fresh one with the standard ALC's weights.
-///
-/// The weights are resampled to this scenario's horizon and step. With
-/// [`Representation::RelativeOnset`] and a user's start observed before, they are
-/// also shifted so that the learned start falls where this scene predicts the
-/// relative state the user started in ([`predicted_start_s`]); without an
-/// observed start, or when none is predicted here, they keep their time base.
-fn starting_experience(
-    config: &LearnConfig,
-    setup: &Setup,
-    previous: Option<&Experience>,
-    options: &AggregatorOptions,
-) -> Result<Experience, HarnessError> {
-    let (k, dt) = (setup.horizon, setup.dt);
-    let standard = || {
-        let lane_change = setup.standard_lane_change(&config.planning.standard_alc);
-        config.standard_weights.weights(&lane_change, k, dt)
-    };
-    match previous {
-        Some(previous) => {
-            let mut carried = previous.clone();
-            let anchored = match (options.representation, previous.anchor_s) {
-                (Representation::RelativeOnset, Some(anchor)) => {
-                    // No user starts after the standard ALC (the scenario's premise,
-                    // checked in `prepare`): a later prediction is held there.
-                    let latest = setup.standard_start_step as f64 * dt;
-                    predicted_start_s(setup, &previous.onsets)
-                        .map(|start| (anchor, start.min(latest)))
-                }
-                _ => None,
-            };
-            match anchored {
-                Some((anchor, start)) => {
-                    carried.weights = resample_weights_shifted(
-                        &previous.weights,
-                        previous.metadata.dt,
-                        k,
-                        dt,
-                        start - anchor,
-                    )?;
-                    carried.anchor_s = Some(start);
-                }
-                None => carried.weights = previous.weights_for(k, dt)?,
-            }
-            carried.metadata.dt = dt;
-            carried.metadata.scenario = config.label();
-            Ok(carried)
-        }
-        None => Ok(Experience::new(
-            config.user.style.name(),
-            config.label(),
-            config.method.name(),
-            standard(),
-            dt,
-        )?),
     }
 }
 

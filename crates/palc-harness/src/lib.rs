@@ -31,6 +31,7 @@
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 mod acc;
+mod carry;
 pub mod closed_loop;
 mod config;
 mod drive;

@@ -78,6 +78,41 @@ pub(crate) fn observed_start_s(
     dt: f64,
     target_l: f64,
 ) -> Option<f64> {
+    fitted_lane_change(driven_l, takeover_step, dt, target_l).map(|(start, _)| start)
+}
+
+/// The user's lateral path in a lesson: what the user drove from the takeover on,
+/// and before it, where the system drove, the quintic fitted to the user's part
+/// ([`fitted_lane_change`]; 0 before the fitted start). `None` when no quintic
+/// can be fitted.
+pub(crate) fn user_path(
+    driven_l: &[f64],
+    takeover_step: usize,
+    dt: f64,
+    target_l: f64,
+) -> Option<Vec<f64>> {
+    let (start, duration) = fitted_lane_change(driven_l, takeover_step, dt, target_l)?;
+    Some(
+        (driven_l.iter().enumerate())
+            .map(|(i, &l)| {
+                if i < takeover_step {
+                    target_l * quintic(((i as f64 * dt - start) / duration).clamp(0.0, 1.0))
+                } else {
+                    l
+                }
+            })
+            .collect(),
+    )
+}
+
+/// The quintic lane change `(start, duration)` (s) fitted to the user's profile
+/// after the takeover, as [`observed_start_s`] describes.
+fn fitted_lane_change(
+    driven_l: &[f64],
+    takeover_step: usize,
+    dt: f64,
+    target_l: f64,
+) -> Option<(f64, f64)> {
     if target_l == 0.0 || takeover_step >= driven_l.len() {
         return None;
     }
@@ -92,7 +127,7 @@ pub(crate) fn observed_start_s(
     let t_b = crossing_s(&profile, takeover_step, upper, dt)?;
     let (x_a, x_b) = (quintic_inverse(lower), quintic_inverse(upper));
     let duration = (t_b - t_a) / (x_b - x_a);
-    Some((t_a - x_a * duration).max(0.0))
+    Some(((t_a - x_a * duration).max(0.0), duration))
 }
 
 /// The step at which a start at `start_s` happened: decisions are taken at
@@ -295,6 +330,18 @@ mod tests {
             let found = observed_start_s(&profile, takeover, 0.1, 3.5).unwrap();
             assert!((found - start).abs() < 0.02, "{found} vs {start}");
         }
+    }
+
+    #[test]
+    fn the_users_path_before_the_takeover_is_the_fitted_quintic() {
+        let user = quintic_profile(4.23, 2.1, 0.1, 90);
+        // The system drove its own (late) plan until the takeover at step 47.
+        let driven: Vec<f64> = (0..90).map(|i| if i < 47 { 0.0 } else { user[i] }).collect();
+        let path = user_path(&driven, 47, 0.1, 3.5).unwrap();
+        for (i, (got, want)) in path.iter().zip(&user).enumerate() {
+            assert!((got - want).abs() < 0.01, "step {i}: {got} vs {want}");
+        }
+        assert_eq!(&path[47..], &user[47..]);
     }
 
     #[test]

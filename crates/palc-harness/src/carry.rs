@@ -1,0 +1,151 @@
+//! Carrying an experience into a new scene (docs/paper-mapping.md, "Experience in
+//! relative space"): the weights anchored at the user's start predicted in relative
+//! space, and a rehearsal of the user's path in the new scene's dynamics.
+
+use palc_aggregator::{
+    AggregatorError, AggregatorOptions, Experience, Lesson, Representation, StepOutcome,
+    learn_from_lesson, plan_problem, resample_weights_shifted,
+};
+use palc_planner::{Planner, Problem, State};
+
+use crate::HarnessError;
+use crate::config::LearnConfig;
+use crate::lesson::scenes;
+use crate::onset::predicted_start_s;
+use crate::setup::Setup;
+
+/// The experience a run starts from: `previous` carried into this scenario, or a
+/// fresh one with the standard ALC's weights; with it, the user's path to rehearse
+/// in this scene when there is one.
+///
+/// The weights are resampled to this scenario's horizon and step. With
+/// [`Representation::RelativeOnset`] and a user's start observed before, they are
+/// also shifted so that the learned start falls where this scene predicts the
+/// relative state the user started in ([`predicted_start_s`]), held no later than
+/// the standard ALC's start (no user starts after it: the scenario's premise); the
+/// last lesson's path is shifted alike and returned for [`rehearse`]. Without an
+/// observed start, or when none is predicted here, the weights keep their time base.
+pub(crate) fn starting_experience(
+    config: &LearnConfig,
+    setup: &Setup,
+    previous: Option<&Experience>,
+    options: &AggregatorOptions,
+) -> Result<(Experience, Option<Vec<f64>>), HarnessError> {
+    let (k, dt) = (setup.horizon, setup.dt);
+    let Some(previous) = previous else {
+        let lane_change = setup.standard_lane_change(&config.planning.standard_alc);
+        let weights = config.standard_weights.weights(&lane_change, k, dt);
+        let fresh = Experience::new(
+            config.user.style.name(),
+            config.label(),
+            config.method.name(),
+            weights,
+            dt,
+        )?;
+        return Ok((fresh, None));
+    };
+    let mut carried = previous.clone();
+    carried.metadata.dt = dt;
+    carried.metadata.scenario = config.label();
+    let anchored = match (options.representation, previous.anchor_s) {
+        (Representation::RelativeOnset, Some(anchor)) => {
+            let latest = setup.standard_start_step as f64 * dt;
+            predicted_start_s(setup, &previous.onsets).map(|start| (anchor, start.min(latest)))
+        }
+        _ => None,
+    };
+    let Some((anchor, start)) = anchored else {
+        carried.weights = previous.weights_for(k, dt)?;
+        carried.demonstration = None;
+        return Ok((carried, None));
+    };
+    let shift = start - anchor;
+    let from_dt = previous.metadata.dt;
+    carried.weights = resample_weights_shifted(&previous.weights, from_dt, k, dt, shift)?;
+    carried.anchor_s = Some(start);
+    let path = (previous.demonstration.as_deref())
+        .filter(|path| !path.is_empty())
+        .map(|path| shifted_path(path, from_dt, k, dt, shift));
+    carried.demonstration.clone_from(&path);
+    Ok((carried, path))
+}
+
+/// `path` (step `from_dt`) at steps `0..=horizon` of `to_dt`, moved `shift_s`
+/// later: linear between samples, its first value held before its start and its
+/// last after its end. `path` is not empty.
+fn shifted_path(path: &[f64], from_dt: f64, horizon: usize, to_dt: f64, shift_s: f64) -> Vec<f64> {
+    let last = path.len() - 1;
+    (0..=horizon)
+        .map(|i| {
+            let position = ((i as f64 * to_dt - shift_s) / from_dt).clamp(0.0, last as f64);
+            let below = position.floor() as usize;
+            let above = (below + 1).min(last);
+            let fraction = position - below as f64;
+            path[below] + fraction * (path[above] - path[below])
+        })
+        .collect()
+}
+
+/// Rehearses the user's `path` (at steps `0..=K` of this scene) before the first
+/// lane change: one lesson in which the user drove the whole path, learned as any
+/// other ([`learn_from_lesson`]), so that the carried weights produce that path in
+/// this scene's dynamics (its speeds, horizon and terminal condition) and not only
+/// in the scene they were learned in. The lesson counter is left as it was: a
+/// rehearsal is not a takeover. When the rehearsal cannot be learned (an expert
+/// that cannot be planned), the carried experience is returned unchanged.
+pub(crate) fn rehearse(
+    planner: &mut Planner,
+    setup: &Setup,
+    template: &Problem,
+    experience: Experience,
+    path: &[f64],
+    options: &AggregatorOptions,
+) -> Experience {
+    let rehearsed = (|| -> Result<StepOutcome, AggregatorError> {
+        let (problem, _) = plan_problem(
+            planner,
+            &experience,
+            template,
+            &scenes(setup, None),
+            options,
+        )?;
+        let planned = planner.plan(&problem)?;
+        let executed = (path.iter().enumerate())
+            .map(|(i, &l)| {
+                let [s, v] = setup.lane_keeping[i];
+                State { s, v, l, phi: 0.0 }
+            })
+            .collect();
+        let lesson = Lesson {
+            step_scenes: scenes(setup, Some(&planned.states)),
+            planned,
+            executed,
+            takeover_step: 0,
+            samples: Vec::new(),
+        };
+        learn_from_lesson(planner, &experience, &lesson, template, options)
+    })();
+    match rehearsed {
+        Ok(outcome) => Experience {
+            metadata: experience.metadata.clone(),
+            ..outcome.experience
+        },
+        Err(_) => experience,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_shifted_path_holds_both_ends() {
+        let path = [0.0, 1.0, 2.0, 3.0];
+        let later = shifted_path(&path, 0.1, 5, 0.1, 0.15);
+        let expected = [0.0, 0.0, 0.5, 1.5, 2.5, 3.0];
+        for (got, want) in later.iter().zip(expected) {
+            assert!((got - want).abs() < 1e-12, "{later:?}");
+        }
+        assert_eq!(shifted_path(&path, 0.1, 3, 0.1, 0.0), path.to_vec());
+    }
+}
