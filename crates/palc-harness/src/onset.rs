@@ -336,7 +336,9 @@ mod tests {
     fn the_users_path_before_the_takeover_is_the_fitted_quintic() {
         let user = quintic_profile(4.23, 2.1, 0.1, 90);
         // The system drove its own (late) plan until the takeover at step 47.
-        let driven: Vec<f64> = (0..90).map(|i| if i < 47 { 0.0 } else { user[i] }).collect();
+        let driven: Vec<f64> = (0..90)
+            .map(|i| if i < 47 { 0.0 } else { user[i] })
+            .collect();
         let path = user_path(&driven, 47, 0.1, 3.5).unwrap();
         for (i, (got, want)) in path.iter().zip(&user).enumerate() {
             assert!((got - want).abs() < 0.01, "step {i}: {got} vs {want}");
