@@ -21,7 +21,7 @@ use crate::learn::{RunResult, aggregator_options, prepare_for};
 use crate::lesson::{lesson, scenes, zone_feature_set};
 use crate::method::Method;
 use crate::observer::{LessonEvent, Observer};
-use crate::onset::{observed_start_s, onset_at, user_path};
+use crate::onset::{UserLaneChange, onset_at};
 use crate::record::{LaneChangeRecord, Outcome, RunSummary};
 use crate::safety::{SafetyMetrics, Violation};
 use crate::setup::Setup;
@@ -387,15 +387,15 @@ impl LearningLoop {
         // The samples update the zone, so they take its features (Eq. 1 or a variant).
         let feature_set = zone_feature_set(&self.experience, &self.options);
         let mut lesson = lesson(self.method, &self.setup, drive, takeover_step, feature_set)?;
-        if self.options.representation == Representation::RelativeOnset {
+        let driven_l: Vec<f64> = drive.driven.iter().map(|x| x.l).collect();
+        let (dt, target_l) = (self.setup.dt, self.setup.target_l);
+        let user = UserLaneChange::fit(&driven_l, takeover_step, dt, target_l);
+        if let (Some(user), Representation::RelativeOnset) = (user, self.options.representation) {
             // The expert follows the user's whole path: before the takeover, the
             // quintic fitted to what the user drove after it, not the old plan.
-            let driven_l: Vec<f64> = drive.driven.iter().map(|x| x.l).collect();
-            let (dt, target_l) = (self.setup.dt, self.setup.target_l);
-            if let Some(path) = user_path(&driven_l, takeover_step, dt, target_l) {
-                for (state, l) in lesson.executed.iter_mut().zip(path) {
-                    state.l = l;
-                }
+            let path = user.path(&driven_l, takeover_step, dt);
+            for (state, l) in lesson.executed.iter_mut().zip(path) {
+                state.l = l;
             }
         }
         let result: Result<StepOutcome, AggregatorError> = learn_from_lesson(
@@ -415,7 +415,9 @@ impl LearningLoop {
                 self.pending_times = outcome.timings;
                 self.experience = outcome.experience;
                 self.next_plan = outcome.plan;
-                self.observe_onset(drive, takeover_step);
+                if let Some(user) = user {
+                    self.observe_onset(user.start_s);
+                }
             }
             Err(error) => {
                 observer.lesson(&LessonEvent::Failed {
@@ -433,15 +435,12 @@ impl LearningLoop {
         Ok(())
     }
 
-    /// Records the user's start seen in the lesson of `drive` (its profile from the
-    /// takeover on) in the experience: merged into this scene's onset, which
-    /// becomes the anchor of the weights.
-    fn observe_onset(&mut self, drive: &Drive, takeover_step: usize) {
-        let driven_l: Vec<f64> = drive.driven.iter().map(|x| x.l).collect();
-        let observed =
-            observed_start_s(&driven_l, takeover_step, self.setup.dt, self.setup.target_l)
-                .and_then(|start| onset_at(&self.setup, start));
-        let Some(observed) = observed else { return };
+    /// Records the user's start `start_s` seen in a lesson in the experience:
+    /// merged into this scene's onset, which becomes the anchor of the weights.
+    fn observe_onset(&mut self, start_s: f64) {
+        let Some(observed) = onset_at(&self.setup, start_s) else {
+            return;
+        };
         let onsets = &mut self.experience.onsets;
         let merged = match onsets.last() {
             Some(last) if last.scenario == observed.scenario => {

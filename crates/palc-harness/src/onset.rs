@@ -68,66 +68,69 @@ fn crossing_s(profile: &[f64], from: usize, level: f64, dt: f64) -> Option<f64> 
     })
 }
 
-/// The user's start (s after the start of the plan) seen in a lesson: the lateral
-/// positions `driven_l` driven by the user from `takeover_step` on, towards
-/// `target_l` from 0. `None` when the profile after the takeover is too short to
-/// fit (the user was past 70 % of the lane change at the takeover).
-pub(crate) fn observed_start_s(
-    driven_l: &[f64],
-    takeover_step: usize,
-    dt: f64,
-    target_l: f64,
-) -> Option<f64> {
-    fitted_lane_change(driven_l, takeover_step, dt, target_l).map(|(start, _)| start)
+/// The user's own lane change seen in a lesson: the quintic fitted to the lateral
+/// positions `driven_l` the user drove from `takeover_step` on, towards `target_l`
+/// from 0.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct UserLaneChange {
+    /// The user's start (s after the start of the plan).
+    pub start_s: f64,
+    /// Its duration (s).
+    pub duration_s: f64,
+    /// The lateral offset it ends at (m).
+    pub target_l: f64,
 }
 
-/// The user's lateral path in a lesson: what the user drove from the takeover on,
-/// and before it, where the system drove, the quintic fitted to the user's part
-/// ([`fitted_lane_change`]; 0 before the fitted start). `None` when no quintic
-/// can be fitted.
-pub(crate) fn user_path(
-    driven_l: &[f64],
-    takeover_step: usize,
-    dt: f64,
-    target_l: f64,
-) -> Option<Vec<f64>> {
-    let (start, duration) = fitted_lane_change(driven_l, takeover_step, dt, target_l)?;
-    Some(
+impl UserLaneChange {
+    /// The fit described in the module documentation. `None` when the profile
+    /// after the takeover is too short to fit (the user was past 70 % of the lane
+    /// change at the takeover).
+    pub(crate) fn fit(
+        driven_l: &[f64],
+        takeover_step: usize,
+        dt: f64,
+        target_l: f64,
+    ) -> Option<UserLaneChange> {
+        if target_l == 0.0 || takeover_step >= driven_l.len() {
+            return None;
+        }
+        let profile: Vec<f64> = driven_l.iter().map(|l| l / target_l).collect();
+        let at_takeover = profile[takeover_step];
+        let lower = LOWER_FRACTION.max(at_takeover + 0.01);
+        let upper = (lower + FRACTION_SPAN).min(0.9);
+        if upper - lower < MIN_FRACTION_SPAN {
+            return None;
+        }
+        let t_a = crossing_s(&profile, takeover_step, lower, dt)?;
+        let t_b = crossing_s(&profile, takeover_step, upper, dt)?;
+        let (x_a, x_b) = (quintic_inverse(lower), quintic_inverse(upper));
+        let duration = (t_b - t_a) / (x_b - x_a);
+        Some(UserLaneChange {
+            start_s: (t_a - x_a * duration).max(0.0),
+            duration_s: duration,
+            target_l,
+        })
+    }
+
+    /// The fitted lateral position (m) at time `t` (s): 0 before the start.
+    fn lateral(&self, t: f64) -> f64 {
+        self.target_l * quintic(((t - self.start_s) / self.duration_s).clamp(0.0, 1.0))
+    }
+
+    /// The user's lateral path in the lesson it was fitted to: what the user drove
+    /// (`driven_l`) from `takeover_step` on, and before it, where the system drove,
+    /// this quintic.
+    pub(crate) fn path(&self, driven_l: &[f64], takeover_step: usize, dt: f64) -> Vec<f64> {
         (driven_l.iter().enumerate())
             .map(|(i, &l)| {
                 if i < takeover_step {
-                    target_l * quintic(((i as f64 * dt - start) / duration).clamp(0.0, 1.0))
+                    self.lateral(i as f64 * dt)
                 } else {
                     l
                 }
             })
-            .collect(),
-    )
-}
-
-/// The quintic lane change `(start, duration)` (s) fitted to the user's profile
-/// after the takeover, as [`observed_start_s`] describes.
-fn fitted_lane_change(
-    driven_l: &[f64],
-    takeover_step: usize,
-    dt: f64,
-    target_l: f64,
-) -> Option<(f64, f64)> {
-    if target_l == 0.0 || takeover_step >= driven_l.len() {
-        return None;
+            .collect()
     }
-    let profile: Vec<f64> = driven_l.iter().map(|l| l / target_l).collect();
-    let at_takeover = profile[takeover_step];
-    let lower = LOWER_FRACTION.max(at_takeover + 0.01);
-    let upper = (lower + FRACTION_SPAN).min(0.9);
-    if upper - lower < MIN_FRACTION_SPAN {
-        return None;
-    }
-    let t_a = crossing_s(&profile, takeover_step, lower, dt)?;
-    let t_b = crossing_s(&profile, takeover_step, upper, dt)?;
-    let (x_a, x_b) = (quintic_inverse(lower), quintic_inverse(upper));
-    let duration = (t_b - t_a) / (x_b - x_a);
-    Some(((t_a - x_a * duration).max(0.0), duration))
 }
 
 /// The step at which a start at `start_s` happened: decisions are taken at
@@ -327,7 +330,9 @@ mod tests {
     fn the_start_of_a_quintic_is_found_between_steps() {
         for (start, duration, takeover) in [(4.23, 2.1, 46), (4.23, 2.1, 30), (1.07, 1.7, 13)] {
             let profile = quintic_profile(start, duration, 0.1, 120);
-            let found = observed_start_s(&profile, takeover, 0.1, 3.5).unwrap();
+            let found = UserLaneChange::fit(&profile, takeover, 0.1, 3.5)
+                .unwrap()
+                .start_s;
             assert!((found - start).abs() < 0.02, "{found} vs {start}");
         }
     }
@@ -339,7 +344,9 @@ mod tests {
         let driven: Vec<f64> = (0..90)
             .map(|i| if i < 47 { 0.0 } else { user[i] })
             .collect();
-        let path = user_path(&driven, 47, 0.1, 3.5).unwrap();
+        let path = UserLaneChange::fit(&driven, 47, 0.1, 3.5)
+            .unwrap()
+            .path(&driven, 47, 0.1);
         for (i, (got, want)) in path.iter().zip(&user).enumerate() {
             assert!((got - want).abs() < 0.01, "step {i}: {got} vs {want}");
         }
@@ -350,8 +357,8 @@ mod tests {
     fn a_profile_seen_too_late_gives_no_start() {
         let profile = quintic_profile(1.0, 2.0, 0.1, 60);
         // At step 25 the user is past 80 % of the lane change.
-        assert_eq!(observed_start_s(&profile, 25, 0.1, 3.5), None);
-        assert_eq!(observed_start_s(&profile, 5, 0.1, 0.0), None);
+        assert_eq!(UserLaneChange::fit(&profile, 25, 0.1, 3.5), None);
+        assert_eq!(UserLaneChange::fit(&profile, 5, 0.1, 0.0), None);
     }
 
     fn onset(headway: f64, ttc: f64, lag: Option<f64>) -> Onset {
