@@ -16,7 +16,7 @@ use crate::{
 /// measurement), experience anchored at the user's start
 /// ([`Representation::RelativeOnset`]). [`AggregatorOptions::paper`] gives the
 /// paper's method.
-#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct AggregatorOptions {
     /// Expert trajectory generator.
@@ -38,6 +38,14 @@ pub struct AggregatorOptions {
     pub bounds: BoundsConfig,
     /// How the learned weights carry into another scene.
     pub representation: Representation,
+    /// Average the lessons of a scene (applied by the loop, `palc_harness`): the
+    /// expert of the n-th lesson follows the mean of the n paths the user drove in
+    /// this scene, each taken at the same fraction of its own lane change, instead
+    /// of the last one alone, so that a user who varies from lane change to lane
+    /// change is learned at the mean of what they do rather than chased draw after
+    /// draw. A first lesson is learned as it is, and a new scene starts a new mean.
+    /// Default `true`; the paper's method learns from the last lesson alone.
+    pub average_lessons: bool,
 }
 
 /// How learned weights carry into another scene (docs/paper-mapping.md,
@@ -56,6 +64,23 @@ pub enum Representation {
     RelativeOnset,
 }
 
+impl Default for AggregatorOptions {
+    fn default() -> Self {
+        AggregatorOptions {
+            expert: ExpertKind::default(),
+            correction: CorrectionRule::default(),
+            learnable_rows: LearnableRows::default(),
+            feature_scale: FeatureScale::default(),
+            convex_set: ConvexSet::default(),
+            use_zone: false,
+            zone: ZoneConfig::default(),
+            bounds: BoundsConfig::default(),
+            representation: Representation::default(),
+            average_lessons: true,
+        }
+    }
+}
+
 impl AggregatorOptions {
     /// The paper's method: zone-centre expert (Eqs. 24-26), apprenticeship learning
     /// (Eqs. 33-36) on all ten rows, zone on (scaled features and the convex set stay,
@@ -67,6 +92,7 @@ impl AggregatorOptions {
             learnable_rows: LearnableRows::ALL,
             use_zone: true,
             representation: Representation::TimeIndexed,
+            average_lessons: false,
             ..AggregatorOptions::default()
         }
     }

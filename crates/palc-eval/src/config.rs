@@ -19,6 +19,7 @@ use palc_traffic::{SpeedCaseConfig, TestbedConfig};
 use serde::{Deserialize, Serialize};
 
 use crate::EvalError;
+use crate::ablation::AblationConfig;
 
 /// The parsed evaluation config.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -39,6 +40,9 @@ pub struct EvalConfig {
     pub timing: TimingConfig,
     /// The qualitative example (Fig. 6).
     pub example: ExampleConfig,
+    /// The ablation ladder from `paper` to `palc`; none if absent.
+    #[serde(default)]
+    pub ablation: AblationConfig,
     /// The `--quick` subset.
     pub quick: QuickConfig,
 }
@@ -237,6 +241,8 @@ pub struct Selection {
     pub timing: TimingConfig,
     /// The example.
     pub example: ExampleConfig,
+    /// The ablation ladder's users and rungs.
+    pub ablation: AblationConfig,
 }
 
 /// Parses TOML text; an error names the dotted path of the field it is in (e.g.
@@ -273,6 +279,7 @@ impl EvalConfig {
                 closed_loop: self.closed_loop.clone(),
                 timing: self.timing.clone(),
                 example: self.example.clone(),
+                ablation: self.ablation.clone(),
             });
         }
         let users = (self.quick.users.iter())
@@ -297,6 +304,10 @@ impl EvalConfig {
             closed_loop: self.quick.closed_loop.clone(),
             timing: self.quick.timing.clone(),
             example: self.example.clone(),
+            ablation: AblationConfig {
+                users: quick(&self.ablation.users),
+                ..self.ablation.clone()
+            },
         })
     }
 
@@ -358,6 +369,7 @@ impl EvalConfig {
                 "transfer.accumulation_users",
                 &self.transfer.accumulation_users,
             ),
+            ("ablation.users", &self.ablation.users),
         ] {
             for name in names {
                 self.user(name, field)?;
@@ -385,6 +397,7 @@ impl EvalConfig {
                 "at least one user kind",
             ));
         }
+        self.ablation.resolve()?;
         self.timing.validate("timing")?;
         self.quick.timing.validate("quick.timing")?;
         check_headway("example.headway_m", self.example.headway_m)

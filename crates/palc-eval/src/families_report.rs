@@ -40,8 +40,10 @@ pub fn section(out: &mut String, all: &[RunRow], methods: &[Method], kinds: &[Us
          one set of settings for every kind: nothing in `palc` is tuned per family. A kind counts as \
          learned when at least {:.0} % of its counted runs personalize; refused runs (a user without \
          a sane lane change in the scene, named in the refusals section) are not counted. For users \
-         with spread, the final takeover rate over the last window is shown against the ceiling (the \
-         rate of the user's own nominal lane change on the same draws). The transfer column pairs each \
+         with spread, the takeover rate is shown against the ceiling (the rate of the user's own \
+         nominal lane change on the same draws): in the evaluation phase after learning (`frozen`: \
+         `loop.frozen_lane_changes` further lane changes, learning frozen), with the number of runs \
+         whose rate is within 3 points of the ceiling, or else over the last window. The transfer column pairs each \
          `[transfer]` run of the kind with the same cell learned from scratch: mean takeovers without \
          and with the experience of the other scene, and the reduction.\n",
         FAMILY_SUCCESS_TARGET * 100.0
@@ -70,8 +72,13 @@ pub fn section(out: &mut String, all: &[RunRow], methods: &[Method], kinds: &[Us
             let deviation = (!deviations.is_empty())
                 .then(|| deviations.iter().sum::<f64>() / deviations.len() as f64);
             let rates = if kind.has_spread() {
-                let (rate, ceiling) = stats::final_rates(&counted);
-                format!("{} vs {}", pct(rate), pct(ceiling))
+                match stats::frozen(&counted) {
+                    Some(frozen) => format!("frozen: {}", frozen.describe()),
+                    None => {
+                        let (rate, ceiling) = stats::final_rates(&counted);
+                        format!("{} vs {}", pct(rate), pct(ceiling))
+                    }
+                }
             } else {
                 "-".to_owned()
             };

@@ -17,6 +17,7 @@ use palc_traffic::TestbedConfig;
 use serde::Serialize;
 
 use crate::EvalError;
+use crate::ablation::Rung;
 use crate::plan::{Experiment, RunSpec};
 use crate::results::{Iteration, RunRow, Status};
 use crate::runner::Executor;
@@ -26,6 +27,7 @@ use crate::runner::Executor;
 pub struct HarnessRuns {
     base: LearnConfig,
     testbed: TestbedConfig,
+    rungs: Vec<Rung>,
 }
 
 impl HarnessRuns {
@@ -38,7 +40,23 @@ impl HarnessRuns {
                 "the test bed whose cells the evaluation runs",
             )
         })?;
-        Ok(HarnessRuns { base, testbed })
+        Ok(HarnessRuns {
+            base,
+            testbed,
+            rungs: Vec::new(),
+        })
+    }
+
+    /// These runs with the ablation ladder's rungs, which runs with a `rung`
+    /// take their label rule and aggregator options from.
+    pub fn with_rungs(mut self, rungs: Vec<Rung>) -> HarnessRuns {
+        self.rungs = rungs;
+        self
+    }
+
+    /// The ablation ladder's rungs.
+    pub fn rungs(&self) -> &[Rung] {
+        &self.rungs
     }
 
     /// The test bed of the base config: speed cases, headways and seeds.
@@ -47,7 +65,8 @@ impl HarnessRuns {
     }
 
     /// The learning config of one run: the base with the run's method, cell,
-    /// user and (timing experiment) step and horizon margin.
+    /// user, (timing experiment) step and horizon margin and (ablation) the
+    /// rung's label rule and aggregator options.
     pub fn config(&self, spec: &RunSpec) -> Result<LearnConfig, EvalError> {
         let user = UserConfig {
             spread: spec.user.has_spread().then(|| Spread {
@@ -74,6 +93,18 @@ impl HarnessRuns {
         }
         if spec.experiment == Experiment::ClosedLoop {
             config.planning.closed_loop.enabled = true;
+        }
+        if let Some(name) = &spec.rung {
+            let rung = (self.rungs.iter().find(|r| &r.name == name)).ok_or_else(|| {
+                EvalError::Unknown {
+                    kind: "ablation rung",
+                    name: name.clone(),
+                    field: format!("run {}", spec.label()),
+                    known: self.rungs.iter().map(|r| r.name.clone()).collect(),
+                }
+            })?;
+            config.method = rung.labels;
+            config.aggregator = Some(rung.options.clone());
         }
         config.validate().map_err(|source| EvalError::Run {
             run: spec.label(),
@@ -158,6 +189,7 @@ fn row(spec: &RunSpec, result: &RunResult, iterations: Vec<Iteration>, wall_s: f
         final_max_deviation_m: Some(summary.final_max_deviation_m),
         final_takeover_rate: Some(summary.final_takeover_rate),
         ceiling_takeover_rate: Some(summary.ceiling_takeover_rate),
+        frozen: summary.frozen,
         horizon: result.horizon,
         dt: Some(result.dt),
         wall_s,

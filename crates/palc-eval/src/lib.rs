@@ -30,6 +30,8 @@
 #![warn(clippy::print_stdout, clippy::print_stderr)]
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
+pub mod ablation;
+pub mod ablation_report;
 pub mod claims;
 pub mod closed_loop_report;
 pub mod config;
@@ -132,6 +134,8 @@ impl Evaluation {
         let harness = HarnessRuns::new(base).map_err(|e| e.in_file(&base_path))?;
         let selection =
             (config.select(quick, harness.testbed())).map_err(|e| e.in_file(config_path))?;
+        let rungs = (selection.ablation.resolve()).map_err(|e| e.in_file(config_path))?;
+        let harness = harness.with_rungs(rungs);
         Ok(Evaluation {
             config_path: config_path.to_owned(),
             base_path,
@@ -179,6 +183,7 @@ impl Evaluation {
             dt: None,
             horizon_margin_s: None,
             experience_from: None,
+            rung: None,
         })
     }
 }
@@ -260,6 +265,7 @@ pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcom
         example: example.as_ref().map_err(Clone::clone),
         figures: &figures,
         manifest: &manifest,
+        ablation: (evaluation.harness.rungs(), &selection.ablation.users),
     });
     write(&out.join("REPORT.md"), &report_text)?;
     // The example's files of an earlier run are removed when this one has none.

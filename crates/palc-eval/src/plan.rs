@@ -28,6 +28,11 @@ pub enum Experiment {
     /// A scene of a sequence one user drives, each started with the experience
     /// of the scene before (`transfer.accumulation_users`).
     Accumulation,
+    /// A grid cell run with a rung of the ablation ladder (`[ablation]`), from scratch.
+    Ablation,
+    /// An ablation cell started with the experience of the same rung in the
+    /// cell's other scene (`transfer.source`).
+    AblationTransfer,
 }
 
 impl Experiment {
@@ -40,6 +45,8 @@ impl Experiment {
             Experiment::ClosedLoop => "closed-loop",
             Experiment::Matrix => "transfer-matrix",
             Experiment::Accumulation => "accumulation",
+            Experiment::Ablation => "ablation",
+            Experiment::AblationTransfer => "ablation-transfer",
         }
     }
 }
@@ -69,6 +76,10 @@ pub struct RunSpec {
     pub horizon_margin_s: Option<f64>,
     /// Index of the run whose learned experience this run starts from.
     pub experience_from: Option<usize>,
+    /// The ablation rung this run uses (its label rule and aggregator options;
+    /// `method` is the rung's label rule); none outside the ablation.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rung: Option<String>,
 }
 
 /// What identifies a scenario and user apart from the experiment: a transfer
@@ -90,10 +101,14 @@ impl RunSpec {
 
     /// A short label for progress lines and error lists.
     pub fn label(&self) -> String {
+        let method = match &self.rung {
+            Some(rung) => format!("[{rung}]"),
+            None => self.method.name().to_owned(),
+        };
         let mut label = format!(
             "{} {} {} {} / {} m / seed {} / {}",
             self.experiment.name(),
-            self.method.name(),
+            method,
             self.user.name,
             self.style,
             self.headway_m,
@@ -162,6 +177,7 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
                                 dt: None,
                                 horizon_margin_s: None,
                                 experience_from: None,
+                                rung: None,
                             });
                         }
                     }
@@ -188,6 +204,7 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
                         dt: Some(dt),
                         horizon_margin_s: Some(margin),
                         experience_from: None,
+                        rung: None,
                     });
                 }
             }
@@ -206,16 +223,55 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
             ..spec
         });
     }
+    // The ablation ladder: every grid cell of its users, once per rung.
+    let rungs = selection.ablation.resolve()?;
+    for rung in &rungs {
+        for user in (selection.users.iter()).filter(|u| selection.ablation.users.contains(&u.name))
+        {
+            for case in &grid.speed_cases {
+                for &headway_m in &grid.headways_m {
+                    for style in &grid.styles {
+                        for &seed in &grid.seeds {
+                            first.push(RunSpec {
+                                id: first.len(),
+                                experiment: Experiment::Ablation,
+                                method: rung.labels,
+                                user: user.clone(),
+                                style: *style,
+                                speed_case: case.clone(),
+                                headway_m,
+                                seed,
+                                dt: None,
+                                horizon_margin_s: None,
+                                experience_from: None,
+                                rung: Some(rung.name.clone()),
+                            });
+                        }
+                    }
+                }
+            }
+        }
+    }
     let mut transfer = Vec::new();
-    for target in first.iter().filter(|s| s.experiment == Experiment::Grid) {
-        if !selection.transfer.users.contains(&target.user.name) {
+    let with_experience = |s: &RunSpec| match s.experiment {
+        Experiment::Grid => Some(Experiment::Transfer),
+        Experiment::Ablation => Some(Experiment::AblationTransfer),
+        _ => None,
+    };
+    for target in &first {
+        let Some(experiment) = with_experience(target) else {
+            continue;
+        };
+        if experiment == Experiment::Transfer
+            && !selection.transfer.users.contains(&target.user.name)
+        {
             continue;
         }
         let source = transfer_source(selection, target, &first);
         let Some(source) = source else { continue };
         transfer.push(RunSpec {
             id: first.len() + transfer.len(),
-            experiment: Experiment::Transfer,
+            experiment,
             experience_from: Some(source),
             ..target.clone()
         });
@@ -305,8 +361,9 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
     Ok(RunPlan { first, transfer })
 }
 
-/// The phase-one grid run whose experience `target` starts from; `None` when the
-/// grid has a single speed case (or headway), so that there is no other scenario.
+/// The phase-one run (of `target`'s experiment and rung) whose experience
+/// `target` starts from; `None` when the grid has a single speed case (or
+/// headway), so that there is no other scenario.
 fn transfer_source(selection: &Selection, target: &RunSpec, first: &[RunSpec]) -> Option<usize> {
     let grid = &selection.grid;
     let next = |len: usize, index: usize| (index + 1) % len;
@@ -329,7 +386,8 @@ fn transfer_source(selection: &Selection, target: &RunSpec, first: &[RunSpec]) -
         }
     };
     let source = first.iter().find(|s| {
-        s.experiment == Experiment::Grid
+        s.experiment == target.experiment
+            && s.rung == target.rung
             && s.method == target.method
             && s.user == target.user
             && s.style == target.style
@@ -414,6 +472,7 @@ pub(crate) mod tests {
                 headway_m: 40.0,
                 seed: 1,
             },
+            ablation: crate::ablation::AblationConfig::default(),
         }
     }
 
@@ -520,6 +579,58 @@ pub(crate) mod tests {
                 Some(t.id) == s.experience_from && t.experiment == Experiment::Accumulation
             })
         }));
+    }
+
+    #[test]
+    fn the_ablation_runs_every_cell_once_per_rung_and_transfers_within_its_rung() {
+        let mut selection = selection();
+        selection.transfer.users.clear();
+        selection.ablation = toml::from_str(
+            r#"
+            users = ["deterministic"]
+            [[rungs]]
+            name = "paper"
+            change = "the printed method"
+            method = "paper"
+            [[rungs]]
+            name = "labels"
+            change = "palc's label rule"
+            method = "palc"
+            "#,
+        )
+        .unwrap();
+        let plan = expand(&selection, &testbed()).unwrap();
+        assert!(plan.all().enumerate().all(|(i, s)| s.id == i));
+        let cells = selection.grid.cells();
+        for (rung, labels) in [("paper", Method::Paper), ("labels", Method::Palc)] {
+            let of_rung = |experiment: Experiment| -> Vec<&RunSpec> {
+                (plan.all())
+                    .filter(|s| s.experiment == experiment && s.rung.as_deref() == Some(rung))
+                    .collect()
+            };
+            let scratch = of_rung(Experiment::Ablation);
+            assert_eq!(scratch.len(), cells);
+            assert!(
+                scratch
+                    .iter()
+                    .all(|s| s.method == labels && s.experience_from.is_none())
+            );
+            let with = of_rung(Experiment::AblationTransfer);
+            assert_eq!(with.len(), cells);
+            for target in with {
+                let source = &plan.first[target.experience_from.unwrap()];
+                assert_eq!(source.experiment, Experiment::Ablation);
+                assert_eq!(source.rung, target.rung);
+                assert_ne!(source.speed_case, target.speed_case);
+                assert_eq!(source.headway_m, target.headway_m);
+            }
+        }
+        // The grid's own transfer runs are not made for users outside `transfer.users`.
+        assert!(
+            plan.transfer
+                .iter()
+                .all(|s| s.experiment != Experiment::Transfer)
+        );
     }
 
     #[test]

@@ -29,6 +29,8 @@ pub struct ReportInput<'a> {
     pub figures: &'a [FigureFile],
     /// The manifest.
     pub manifest: &'a Manifest,
+    /// The ablation ladder's rungs and user kinds (empty without ablation runs).
+    pub ablation: (&'a [crate::ablation::Rung], &'a [String]),
 }
 
 /// Writes REPORT.md's text.
@@ -64,6 +66,7 @@ pub fn render(input: &ReportInput) -> String {
     }
     crate::families_report::section(&mut out, input.rows, input.methods, input.user_kinds);
     crate::transfer_report::section(&mut out, input.rows, input.methods);
+    crate::ablation_report::section(&mut out, input.rows, input.ablation.0, input.ablation.1);
     claims_section(&mut out);
     crate::safety_report::section(&mut out, input.rows, input.methods);
     crate::closed_loop_report::section(&mut out, input.rows, input.methods, input.users);
@@ -103,7 +106,10 @@ fn user_section(out: &mut String, input: &ReportInput, user: &str) {
             "Each lane change draws the user's headway and duration within ±{:.0} %; such a user \
              counts as personalized when the takeover rate over the last window comes within the \
              harness's margin of the ceiling (the rate of the user's own nominal plan on the same \
-             draws), not by the paper's three clean lane changes in a row.",
+             draws), not by the paper's three clean lane changes in a row. After the run, the plan \
+             it ended with is driven `loop.frozen_lane_changes` more times with learning frozen, \
+             each time against a new draw, and judged against the nominal plan on the same draws: \
+             the honest measure of what the user lives with.",
             spread * 100.0
         ),
         None => "Deterministic users are the paper's set-up.".to_owned(),
@@ -213,6 +219,30 @@ fn ceiling_line(out: &mut String, input: &ReportInput, grids: &[Vec<&RunRow>]) {
     let _ = writeln!(
         out,
         "| final takeover rate vs the nominal plan's | (not in the paper) | {} | {} |",
+        cells.join(" | "),
+        verdicts.join("; ")
+    );
+    let phases: Vec<Option<stats::Frozen>> = grids.iter().map(|g| stats::frozen(g)).collect();
+    if phases.iter().all(Option::is_none) {
+        return;
+    }
+    let cells: Vec<String> = (phases.iter())
+        .map(|f| f.map_or("n/a".to_owned(), |f| f.describe()))
+        .collect();
+    let verdicts: Vec<String> = (input.methods.iter().zip(&phases))
+        .map(|(m, f)| match f {
+            Some(f) if f.within_margin as f64 >= 0.95 * f.runs as f64 => {
+                format!("{}: holds", m.name())
+            }
+            Some(_) => format!("{}: does not hold", m.name()),
+            None => format!("{}: not measured", m.name()),
+        })
+        .collect();
+    let _ = writeln!(
+        out,
+        "| after learning, frozen: takeover rate vs the nominal plan's, users within {:.0} points | \
+         (not in the paper; goal: 95 % of users) | {} | {} |",
+        100.0 * stats::FROZEN_MARGIN,
         cells.join(" | "),
         verdicts.join("; ")
     );
@@ -553,6 +583,7 @@ mod tests {
             example: Err("not run in this test".into()),
             figures: &[],
             manifest: &manifest,
+            ablation: (&[], &[]),
         });
         assert!(
             report

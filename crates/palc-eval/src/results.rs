@@ -77,7 +77,7 @@ pub struct Iteration {
     pub closed_loop: Option<ClosedLoopStats>,
 }
 
-use palc_harness::{ClosedLoopStats, SafetyMetrics, Violation};
+use palc_harness::{ClosedLoopStats, FrozenEvaluation, SafetyMetrics, Violation};
 
 /// Names of the parts of [`Iteration::times_s`].
 pub const PART_NAMES: [&str; 5] = palc_harness::Timings::PART_NAMES;
@@ -108,6 +108,9 @@ pub struct RunRow {
     pub final_takeover_rate: Option<f64>,
     /// Takeover rate of the user's nominal plan on the same draws.
     pub ceiling_takeover_rate: Option<f64>,
+    /// Users with spread: the lane changes driven after the run, learning frozen.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub frozen: Option<FrozenEvaluation>,
     /// Planning horizon K.
     pub horizon: usize,
     /// Step (s).
@@ -131,6 +134,7 @@ impl RunRow {
             final_max_deviation_m: None,
             final_takeover_rate: None,
             ceiling_takeover_rate: None,
+            frozen: None,
             horizon: 0,
             dt: None,
             wall_s,
@@ -207,6 +211,9 @@ struct CsvRow<'a> {
     final_max_deviation_m: Option<f64>,
     final_takeover_rate: Option<f64>,
     ceiling_takeover_rate: Option<f64>,
+    frozen_lane_changes: Option<usize>,
+    frozen_takeover_rate: Option<f64>,
+    frozen_ceiling_rate: Option<f64>,
     mean_compute_per_iteration_s: Option<f64>,
     experience_from: Option<usize>,
     collisions: usize,
@@ -251,6 +258,9 @@ pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> Result<(), EvalEr
             final_max_deviation_m: row.final_max_deviation_m,
             final_takeover_rate: row.final_takeover_rate,
             ceiling_takeover_rate: row.ceiling_takeover_rate,
+            frozen_lane_changes: row.frozen.map(|f| f.lane_changes),
+            frozen_takeover_rate: row.frozen.map(|f| f.takeover_rate()),
+            frozen_ceiling_rate: row.frozen.map(|f| f.ceiling_rate()),
             mean_compute_per_iteration_s: row.mean_compute_s(),
             experience_from: row.spec.experience_from,
             collisions: row.lane_changes_where(|i| i.safety.collision),

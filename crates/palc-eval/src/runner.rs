@@ -235,6 +235,7 @@ pub(crate) mod tests {
                 final_max_deviation_m: Some(0.05),
                 final_takeover_rate: Some(0.0),
                 ceiling_takeover_rate: Some(0.0),
+                frozen: None,
                 horizon: (8.0 / dt) as usize,
                 dt: Some(dt),
                 wall_s: 0.01,

@@ -106,18 +106,23 @@ pub struct Transfer {
 
 /// Pairs each transfer run of `rows` with the grid run of its cell.
 pub fn transfer(rows: &[&RunRow]) -> Transfer {
+    transfer_between(rows, Experiment::Grid, Experiment::Transfer)
+}
+
+/// Pairs each run of experiment `with` in `rows` with the run of experiment
+/// `without` of its cell (the ablation's transfer runs with the rung's runs from
+/// scratch: `rows` then holds one rung).
+pub fn transfer_between(rows: &[&RunRow], without: Experiment, with: Experiment) -> Transfer {
+    let (from_scratch, with_experience) = (without, with);
     let grid: HashMap<CellKey, &RunRow> = rows
         .iter()
-        .filter(|r| r.spec.experiment == Experiment::Grid)
+        .filter(|r| r.spec.experiment == from_scratch)
         .map(|r| (r.spec.experiment_cell(), *r))
         .collect();
     let (mut without, mut with) = (Vec::new(), Vec::new());
     let mut personalized = (0, 0);
     let mut refused = 0;
-    for row in rows
-        .iter()
-        .filter(|r| r.spec.experiment == Experiment::Transfer)
-    {
+    for row in rows.iter().filter(|r| r.spec.experiment == with_experience) {
         let Some(base) = grid.get(&row.spec.experiment_cell()) else {
             continue;
         };
@@ -347,6 +352,55 @@ pub fn final_rates(rows: &[&RunRow]) -> (Option<f64>, Option<f64>) {
     )
 }
 
+/// Margin over the ceiling within which a user with spread counts as served in
+/// the evaluation phase: 3 percentage points.
+pub const FROZEN_MARGIN: f64 = 0.03;
+
+/// Users with spread: the evaluation phase after learning (learning frozen).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Frozen {
+    /// Counted runs with an evaluation phase.
+    pub runs: usize,
+    /// Mean takeover rate of the frozen plan.
+    pub takeover_rate: f64,
+    /// Mean rate of the nominal plan on the same draws (the ceiling).
+    pub ceiling_rate: f64,
+    /// Runs whose frozen rate is at most the ceiling plus [`FROZEN_MARGIN`].
+    pub within_margin: usize,
+}
+
+/// The evaluation phase over the counted runs of `rows` that have one; `None`
+/// when none has.
+pub fn frozen(rows: &[&RunRow]) -> Option<Frozen> {
+    let phases: Vec<_> = (rows.iter())
+        .filter(|r| r.status.counted())
+        .filter_map(|r| r.frozen)
+        .collect();
+    let n = phases.len();
+    (n > 0).then(|| Frozen {
+        runs: n,
+        takeover_rate: phases.iter().map(|f| f.takeover_rate()).sum::<f64>() / n as f64,
+        ceiling_rate: phases.iter().map(|f| f.ceiling_rate()).sum::<f64>() / n as f64,
+        within_margin: (phases.iter())
+            .filter(|f| f.takeover_rate() <= f.ceiling_rate() + FROZEN_MARGIN + 1e-12)
+            .count(),
+    })
+}
+
+impl Frozen {
+    /// "34 % vs ceiling 27 %, 22/117 within 3 points".
+    pub fn describe(&self) -> String {
+        format!(
+            "{:.0} % vs ceiling {:.0} %, {}/{} within {:.0} points",
+            100.0 * self.takeover_rate,
+            100.0 * self.ceiling_rate,
+            self.within_margin,
+            self.runs,
+            100.0 * FROZEN_MARGIN
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -381,6 +435,7 @@ mod tests {
             dt: None,
             horizon_margin_s: None,
             experience_from: None,
+            rung: None,
         };
         let status = match takeovers {
             Some(_) => Status::Personalized,

@@ -61,6 +61,7 @@ fn subset(evaluation: &Evaluation) -> Selection {
         accumulation_users: Vec::new(),
     };
     selection.closed_loop = Default::default();
+    selection.ablation = Default::default();
     selection.timing = TimingConfig {
         dts: Vec::new(),
         ..selection.timing

@@ -216,13 +216,22 @@ pub struct StoppingConfig {
     pub max_takeovers: usize,
     /// Consecutive takeover-free lane changes that count as success (paper: 3).
     pub success_streak: usize,
-    /// Users with spread: lane changes in the window over which the takeover rate is measured.
+    /// Users with spread: lane changes in the window over which the takeover rate
+    /// is measured. Default `20`.
     pub spread_window: usize,
     /// Users with spread: personalized when the window's takeover rate is at most the
     /// ceiling (the nominal plan's rate on the same draws) plus this margin.
+    /// Default `0.05`: one takeover more than the nominal plan in 20 lane changes.
+    /// (A window of 10 within 0.1 stopped runs whose plan, frozen, was then taken
+    /// over 5 times more than the nominal plan in 50 lane changes:
+    /// docs/paper-mapping.md, "Users with spread".)
     pub spread_margin: f64,
     /// Users with spread: lane changes after which the run stops in any case.
     pub max_lane_changes: usize,
+    /// Users with spread: lane changes driven after the run has ended, with
+    /// learning frozen, each judged by the drawn user against the nominal plan on
+    /// the same draw ([`crate::FrozenEvaluation`]); `0` for none. Default `50`.
+    pub frozen_lane_changes: usize,
 }
 
 impl Default for StoppingConfig {
@@ -230,9 +239,10 @@ impl Default for StoppingConfig {
         Self {
             max_takeovers: 30,
             success_streak: 3,
-            spread_window: 10,
-            spread_margin: 0.1,
+            spread_window: 20,
+            spread_margin: 0.05,
             max_lane_changes: 60,
+            frozen_lane_changes: 50,
         }
     }
 }
@@ -294,6 +304,13 @@ impl LearnConfig {
                     bound: format!("a whole number in [1, {max}]"),
                 });
             }
+        }
+        if s.frozen_lane_changes > MAX_LANE_CHANGES {
+            return Err(HarnessError::InvalidConfig {
+                field: "loop.frozen_lane_changes".to_owned(),
+                value: s.frozen_lane_changes as f64,
+                bound: format!("a whole number in [0, {MAX_LANE_CHANGES}]"),
+            });
         }
         if !(s.spread_margin.is_finite() && (0.0..=1.0).contains(&s.spread_margin)) {
             return Err(HarnessError::InvalidConfig {

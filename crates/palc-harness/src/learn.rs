@@ -39,10 +39,7 @@ pub fn aggregator_options(config: &LearnConfig) -> AggregatorOptions {
     config
         .aggregator
         .clone()
-        .unwrap_or_else(|| match config.method {
-            Method::Paper => AggregatorOptions::paper(),
-            Method::Palc => AggregatorOptions::default(),
-        })
+        .unwrap_or_else(|| config.method.aggregator_options())
 }
 
 /// Builds the scenario of a config and checks the paper's premise in it: the

@@ -22,8 +22,9 @@ use crate::lesson::{lesson, scenes, zone_feature_set};
 use crate::method::Method;
 use crate::observer::{LessonEvent, Observer};
 use crate::onset::{UserLaneChange, onset_at};
-use crate::record::{LaneChangeRecord, Outcome, RunSummary};
+use crate::record::{FrozenEvaluation, LaneChangeRecord, Outcome, RunSummary};
 use crate::safety::{SafetyMetrics, Violation};
+use crate::scene_lessons::SceneLessons;
 use crate::setup::Setup;
 use crate::user::{Expectation, User};
 
@@ -63,6 +64,8 @@ pub struct LearningLoop {
     fallback: Option<(Plan, SafetyMetrics)>,
     /// With `[planning.closed_loop]` on, the closed-loop driver.
     closed_loop: Option<ClosedLoop>,
+    /// The lessons of this run's scene, averaged with `average_lessons`.
+    scene_lessons: SceneLessons,
     /// Compute time of the step that produced `next_plan`.
     pending_times: Timings,
     records: Vec<LaneChangeRecord>,
@@ -188,6 +191,7 @@ impl LearningLoop {
             next_plan,
             fallback,
             closed_loop,
+            scene_lessons: SceneLessons::default(),
             pending_times,
             records: Vec::new(),
             takeovers: 0,
@@ -211,29 +215,7 @@ impl LearningLoop {
     /// or feature error.
     pub fn step(&mut self, observer: &mut dyn Observer) -> Result<&LaneChangeRecord, HarnessError> {
         let index = self.records.len();
-        let (plan, planned_safety, refusal) = self.checked_plan()?;
-        let (plan, closed_loop) = match &self.closed_loop {
-            Some(driver) => {
-                let (plan, stats) = driver.drive(
-                    &self.setup,
-                    &self.experience,
-                    &self.options,
-                    &plan,
-                    refusal.is_some(),
-                )?;
-                (plan, Some(stats))
-            }
-            None => (plan, None),
-        };
-        let refusal = refusal.or(closed_loop.and_then(|c| c.first_refusal));
-        if let Some(violation) = &refusal {
-            observer.safety_refusal(index, violation);
-        }
-        let (drive, nominal_plan_taken_over) = self.drive(plan)?;
-        let mut record = self.record(&drive, nominal_plan_taken_over);
-        record.planned_safety = planned_safety;
-        record.safety_refusal = refusal;
-        record.closed_loop = closed_loop;
+        let (drive, record) = self.drive_next_plan(index, observer)?;
         observer.lane_change(&record);
         self.records.push(record);
         self.pending_times = Timings::default();
@@ -285,7 +267,8 @@ impl LearningLoop {
                 break outcome;
             }
         };
-        let summary = self.summary(outcome);
+        let mut summary = self.summary(outcome);
+        summary.frozen = self.frozen_evaluation(observer)?;
         observer.finished(&summary);
         Ok(RunResult {
             label: self.label,
@@ -311,6 +294,65 @@ impl LearningLoop {
     /// The plan the next lane change will drive.
     pub fn next_plan(&self) -> &Plan {
         &self.next_plan
+    }
+
+    /// Drives the next plan once (through the safety layer and, when configured,
+    /// in closed loop) against the user's next lane change, and records it as lane
+    /// change `index`; refusals go to `observer`.
+    fn drive_next_plan(
+        &mut self,
+        index: usize,
+        observer: &mut dyn Observer,
+    ) -> Result<(Drive, LaneChangeRecord), HarnessError> {
+        let (plan, planned_safety, refusal) = self.checked_plan()?;
+        let (plan, closed_loop) = match &self.closed_loop {
+            Some(driver) => {
+                let (plan, stats) = driver.drive(
+                    &self.setup,
+                    &self.experience,
+                    &self.options,
+                    &plan,
+                    refusal.is_some(),
+                )?;
+                (plan, Some(stats))
+            }
+            None => (plan, None),
+        };
+        let refusal = refusal.or(closed_loop.and_then(|c| c.first_refusal));
+        if let Some(violation) = &refusal {
+            observer.safety_refusal(index, violation);
+        }
+        let (drive, nominal_plan_taken_over) = self.drive(plan)?;
+        let mut record = self.record(&drive, nominal_plan_taken_over);
+        record.index = index;
+        record.planned_safety = planned_safety;
+        record.safety_refusal = refusal;
+        record.closed_loop = closed_loop;
+        Ok((drive, record))
+    }
+
+    /// The evaluation phase of a user with spread (`loop.frozen_lane_changes`):
+    /// the plan the run ended with, driven again against new draws of the user
+    /// without learning, and the nominal plan judged on the same draws. These lane
+    /// changes are not records of the run and observers see only their refusals.
+    fn frozen_evaluation(
+        &mut self,
+        observer: &mut dyn Observer,
+    ) -> Result<Option<FrozenEvaluation>, HarnessError> {
+        let lane_changes = self.stopping.frozen_lane_changes;
+        if !self.user.has_spread() || lane_changes == 0 {
+            return Ok(None);
+        }
+        let mut frozen = FrozenEvaluation {
+            lane_changes,
+            ..FrozenEvaluation::default()
+        };
+        for i in 0..lane_changes {
+            let (drive, record) = self.drive_next_plan(self.records.len() + i, observer)?;
+            frozen.takeovers += usize::from(drive.takeover.is_some());
+            frozen.ceiling_takeovers += usize::from(record.nominal_plan_taken_over);
+        }
+        Ok(Some(frozen))
     }
 
     /// The safety layer (with `safety.enforce`): the learned plan if it is safe, else the standard ALC's
@@ -398,6 +440,14 @@ impl LearningLoop {
                 state.l = l;
             }
         }
+        if let (Some(user), true) = (user, self.options.average_lessons) {
+            // The expert follows the mean of this scene's lessons (scene_lessons.rs).
+            let path: Vec<f64> = lesson.executed.iter().map(|x| x.l).collect();
+            let mean = self.scene_lessons.add(user, path, dt);
+            for (state, l) in lesson.executed.iter_mut().zip(mean) {
+                state.l = l;
+            }
+        }
         let result: Result<StepOutcome, AggregatorError> = learn_from_lesson(
             &mut self.planner,
             &self.experience,
@@ -470,6 +520,7 @@ impl LearningLoop {
             final_max_deviation_m: records.last().map_or(0.0, |r| r.max_deviation_m),
             final_takeover_rate: rate(|r| r.takeover.is_some()),
             ceiling_takeover_rate: rate(|r| r.nominal_plan_taken_over),
+            frozen: None,
         }
     }
 }
@@ -536,6 +587,7 @@ mod tests {
             spread_window: 5,
             spread_margin: 0.1,
             max_lane_changes: 12,
+            frozen_lane_changes: 0,
         }
     }
 

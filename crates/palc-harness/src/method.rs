@@ -10,6 +10,7 @@
 //!   incremental correction of the lateral rows w1 and w2 only, and no zone by
 //!   default, because in measurement a zone on top made convergence worse.
 
+use palc_aggregator::AggregatorOptions;
 use serde::{Deserialize, Serialize};
 
 /// A learning method.
@@ -38,6 +39,15 @@ impl Method {
     /// The method with this name.
     pub fn named(name: &str) -> Option<Method> {
         Method::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// The aggregator options this method runs with when a config gives none:
+    /// [`AggregatorOptions::paper`] or `palc`'s defaults.
+    pub fn aggregator_options(self) -> AggregatorOptions {
+        match self {
+            Method::Paper => AggregatorOptions::paper(),
+            Method::Palc => AggregatorOptions::default(),
+        }
     }
 }
 

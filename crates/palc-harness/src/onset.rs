@@ -113,7 +113,7 @@ impl UserLaneChange {
     }
 
     /// The fitted lateral position (m) at time `t` (s): 0 before the start.
-    fn lateral(&self, t: f64) -> f64 {
+    pub(crate) fn lateral(&self, t: f64) -> f64 {
         self.target_l * quintic(((t - self.start_s) / self.duration_s).clamp(0.0, 1.0))
     }
 

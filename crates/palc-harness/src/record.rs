@@ -121,6 +121,35 @@ pub struct RunSummary {
     pub final_takeover_rate: f64,
     /// Takeover rate of the user's nominal trajectory against the same draws.
     pub ceiling_takeover_rate: f64,
+    /// Users with spread: the lane changes driven after the run ended, learning
+    /// frozen (`loop.frozen_lane_changes`); `None` for a deterministic user.
+    #[serde(default)]
+    pub frozen: Option<FrozenEvaluation>,
+}
+
+/// The evaluation phase of a user with spread: the plan the run ended with, driven
+/// `lane_changes` more times without learning, each time against a new draw of the
+/// user, and the user's nominal plan judged on the same draws (the ceiling).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub struct FrozenEvaluation {
+    /// Lane changes driven.
+    pub lane_changes: usize,
+    /// Of them, taken over.
+    pub takeovers: usize,
+    /// Of them, those in which the user would have taken over the nominal plan.
+    pub ceiling_takeovers: usize,
+}
+
+impl FrozenEvaluation {
+    /// Share of the lane changes taken over.
+    pub fn takeover_rate(&self) -> f64 {
+        self.takeovers as f64 / self.lane_changes.max(1) as f64
+    }
+
+    /// Share of the lane changes in which the nominal plan would have been taken over.
+    pub fn ceiling_rate(&self) -> f64 {
+        self.ceiling_takeovers as f64 / self.lane_changes.max(1) as f64
+    }
 }
 
 impl RunSummary {
@@ -153,6 +182,7 @@ mod tests {
             final_max_deviation_m: 0.5,
             final_takeover_rate: 0.2,
             ceiling_takeover_rate: 0.1,
+            frozen: None,
         };
         assert_eq!(summary.counted_takeovers(), 30);
         let summary = RunSummary {

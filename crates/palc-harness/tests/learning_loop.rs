@@ -104,8 +104,34 @@ fn a_user_with_spread_is_judged_against_the_nominal_ceiling() {
     assert!((0.0..=1.0).contains(&summary.ceiling_takeover_rate));
     assert!(result.records.iter().all(|r| r.with_spread));
     if summary.outcome == Outcome::Personalized {
-        assert!(summary.final_takeover_rate <= summary.ceiling_takeover_rate + 0.1 + 1e-12);
+        let margin = config.stopping.spread_margin;
+        assert!(summary.final_takeover_rate <= summary.ceiling_takeover_rate + margin + 1e-12);
     }
+    // The evaluation phase after learning: the frozen plan against new draws.
+    let frozen = summary
+        .frozen
+        .expect("a user with spread is evaluated frozen");
+    assert_eq!(frozen.lane_changes, config.stopping.frozen_lane_changes);
+    assert!(frozen.takeovers <= frozen.lane_changes);
+    assert!(frozen.ceiling_takeovers <= frozen.lane_changes);
+    assert_eq!(result.records.len(), summary.lane_changes);
+}
+
+#[test]
+fn a_deterministic_user_has_no_evaluation_phase_and_none_can_be_asked_for() {
+    let result = learn(&config(Method::Palc, "neutral"));
+    assert_eq!(result.summary.frozen, None);
+    let mut config = config(Method::Palc, "neutral");
+    config.user.spread = Some(palc_harness::user::Spread {
+        relative: 0.02,
+        seed: 11,
+        parameters: Default::default(),
+    });
+    config.stopping.frozen_lane_changes = 0;
+    assert_eq!(learn(&config).summary.frozen, None);
+    config.stopping.frozen_lane_changes = 1_001;
+    let err = run(&config, None, &mut NoObserver).unwrap_err().to_string();
+    assert!(err.contains("loop.frozen_lane_changes"), "{err}");
 }
 
 #[test]
@@ -250,4 +276,32 @@ fn stepping_the_loop_by_hand_gives_the_run() {
         assert_eq!(x.takeover, y.takeover);
     }
     assert_eq!(by_hand.experience().weights, whole.experience.weights);
+}
+
+#[test]
+fn averaging_lessons_changes_nothing_for_a_user_who_repeats_the_lane_change() {
+    // With the incremental rule a deterministic user needs several lessons, so the
+    // mean is taken; since every lesson shows the same lane change, it is the same.
+    for style in ["aggressive", "cautious"] {
+        let mut options = Method::Palc.aggregator_options();
+        options.correction = palc_aggregator::CorrectionRule::Incremental(
+            palc_aggregator::IncrementalRule::default(),
+        );
+        let mut last_only = config(Method::Palc, style);
+        last_only.aggregator = Some(palc_aggregator::AggregatorOptions {
+            average_lessons: false,
+            ..options.clone()
+        });
+        let mut averaged = last_only.clone();
+        averaged.aggregator = Some(options);
+        let (a, b) = (learn(&last_only), learn(&averaged));
+        assert!(a.summary.takeovers >= 2, "{style}: {:?}", a.summary);
+        assert_eq!(a.summary.takeovers, b.summary.takeovers, "{style}");
+        assert!(
+            (a.summary.final_max_deviation_m - b.summary.final_max_deviation_m).abs() < 0.02,
+            "{style}: {} against {}",
+            a.summary.final_max_deviation_m,
+            b.summary.final_max_deviation_m
+        );
+    }
 }
