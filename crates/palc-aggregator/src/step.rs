@@ -204,7 +204,11 @@ pub fn learn_from_lesson(
         weights: outcome.weights.clone(),
         ..plan_problem
     };
-    let plan = planner.plan(&problem)?;
+    // The rule has solved this very problem when it measured its best iterate.
+    let plan = match outcome.plan {
+        Some(plan) => plan,
+        None => planner.plan(&problem)?,
+    };
     timings.plan_s = start.elapsed().as_secs_f64();
 
     let mut metadata = experience.metadata.clone();

@@ -128,6 +128,10 @@ proptest! {
             prop_assert!(check_convexity(&outcome.experience.weights).is_ok(),
                 "{:?}", check_convexity(&outcome.experience.weights));
             prop_assert_eq!(outcome.experience.weights.horizon(), horizon);
+            // The next plan is the plan of the next problem (a rule's best iterate
+            // is returned as it was solved, not solved again).
+            let replanned = c.planner.plan(&outcome.problem).unwrap();
+            prop_assert_eq!(&outcome.plan.states, &replanned.states);
             // Rows outside the learnable set keep their (projected) prior values
             // unless convexity needed a coupling shrunk.
             let prior = palc_aggregator::project_convex(

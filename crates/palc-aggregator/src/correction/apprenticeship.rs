@@ -120,6 +120,7 @@ impl RewardCorrection for ApprenticeshipRule {
             }),
             error_before: None,
             error_after: None,
+            plan: None,
             inner_solves: 0,
         })
     }

@@ -103,7 +103,8 @@ impl RewardCorrection for IncrementalRule {
         let first = plan(input.weights)?;
         let before = error(&first.features);
         let mut best_weights = input.weights.clone();
-        let mut best_features = first.features;
+        let mut best_features = first.features.clone();
+        let mut best_plan = first;
         let mut best_error = before;
         let mut alpha = self.step_size;
         let mut solves = 1;
@@ -138,7 +139,8 @@ impl RewardCorrection for IncrementalRule {
                 Ok(p) if error(&p.features) < best_error => {
                     best_error = error(&p.features);
                     best_weights = candidate;
-                    best_features = p.features;
+                    best_features = p.features.clone();
+                    best_plan = p;
                 }
                 _ => {
                     alpha *= 0.5;
@@ -154,6 +156,7 @@ impl RewardCorrection for IncrementalRule {
             error_before: Some(before),
             error_after: Some(best_error),
             inner_solves: solves,
+            plan: Some(best_plan),
         })
     }
 }

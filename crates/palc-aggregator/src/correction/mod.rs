@@ -50,6 +50,10 @@ pub struct CorrectionOutcome {
     pub error_after: Option<f64>,
     /// Plans solved inside the rule.
     pub inner_solves: usize,
+    /// The plan of the returned weights, when the rule solved it with the `plan`
+    /// it was given (the next plan's problem): the step takes it as the next plan
+    /// instead of solving the same problem again.
+    pub plan: Option<Plan>,
 }
 
 /// A reward correction rule: turns a lesson's features into one new weight matrix.

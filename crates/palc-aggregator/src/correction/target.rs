@@ -109,7 +109,8 @@ impl RewardCorrection for TargetRule {
         let first = plan(input.weights)?;
         let before = scaled(&first.features);
         let mut best_weights = input.weights.clone();
-        let mut best_features = first.features;
+        let mut best_features = first.features.clone();
+        let mut best_plan = first;
         let mut best_error = lateral_error(&best_features, input.expert);
         let mut gain = self.gain;
         let mut solves = 1;
@@ -138,7 +139,8 @@ impl RewardCorrection for TargetRule {
                 Ok(p) if lateral_error(&p.features, input.expert) < best_error => {
                     best_error = lateral_error(&p.features, input.expert);
                     best_weights = candidate;
-                    best_features = p.features;
+                    best_features = p.features.clone();
+                    best_plan = p;
                 }
                 _ => gain *= 0.5,
             }
@@ -149,6 +151,7 @@ impl RewardCorrection for TargetRule {
             apprenticeship: state.cloned(),
             error_before: before,
             inner_solves: solves,
+            plan: Some(best_plan),
         })
     }
 }
