@@ -10,6 +10,7 @@ use crate::harness_runs::ExampleTrace;
 use crate::plan::Experiment;
 use crate::results::{PART_NAMES, RunRow};
 use crate::stats;
+use crate::transfer_report::{Axis, accumulation_places, matrix_pairs};
 use crate::views::{FigureFile, grid, slug, speed_label, timing, with_transfer};
 
 /// Series of a bar chart: name and one value per category.
@@ -203,6 +204,18 @@ pub fn draw_all(
             &|dir, stem| figures::save(dir, stem, (900, 450), &safety).map(|_| ()),
         )?;
     }
+    for &method in methods {
+        if let Some(figure) = across_scenes(rows, method) {
+            let name = method.name();
+            save(
+                format!("fig15-transfer-{name}"),
+                format!(
+                    "Fig. 15 (not in the paper): `{name}`, mean takeovers from scratch and with experience from another scene: the transfer matrix's pairs by axis, and accumulation (from scratch: scene 1; with experience: the scenes after it; every user kind) (REPORT.md, \"Experience across scenes\")"
+                ),
+                &|dir, stem| figures::save(dir, stem, (900, 450), &figure).map(|_| ()),
+            )?;
+        }
+    }
     let gaps = Lines {
         title: "Smallest net gap per lane change, system-driven steps (grid)".into(),
         x_desc: "smallest net gap to the preceding, lead or lag vehicle (m; < 0: overlap)".into(),
@@ -296,6 +309,51 @@ pub fn draw_all(
         )?;
     }
     Ok(files)
+}
+
+/// Fig. 15: `method`'s transfer matrix pooled by axis, and its accumulation
+/// chains pooled over user kinds (scene 1 against the scenes after it); `None`
+/// without matrix or accumulation runs.
+fn across_scenes(rows: &[RunRow], method: Method) -> Option<Bars> {
+    let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
+    let mut categories = Vec::new();
+    let (mut scratch, mut with) = (Vec::new(), Vec::new());
+    for axis in Axis::BOTH {
+        let pairs = matrix_pairs(rows, method, axis);
+        if pairs.is_empty() {
+            continue;
+        }
+        categories.push(format!("from another {}", axis.name()));
+        scratch.push(mean(&pairs.iter().map(|p| p.without).collect::<Vec<_>>()));
+        with.push(mean(&pairs.iter().map(|p| p.with).collect::<Vec<_>>()));
+    }
+    for axis in Axis::BOTH {
+        let kinds = accumulation_places(rows, method, axis);
+        let first: Vec<f64> = kinds
+            .iter()
+            .flat_map(|(_, p)| p[0].iter().copied())
+            .collect();
+        let after: Vec<f64> = (kinds.iter())
+            .flat_map(|(_, p)| p.iter().skip(1).flatten().copied())
+            .collect();
+        if after.is_empty() {
+            continue;
+        }
+        categories.push(format!("through the {}s", axis.name()));
+        scratch.push(mean(&first));
+        with.push(mean(&after));
+    }
+    (!categories.is_empty()).then(|| Bars {
+        title: format!("Experience across scenes ({})", method.name()),
+        x_desc: "transfer matrix pairs, accumulation chains".into(),
+        y_desc: "mean takeovers (failures at the cap)".into(),
+        categories,
+        series: vec![
+            ("from scratch".into(), scratch),
+            ("with experience".into(), with),
+        ],
+        label_every: 1,
+    })
 }
 
 #[cfg(test)]

@@ -19,20 +19,23 @@ fn mean(values: &[f64]) -> Option<f64> {
 
 /// Which axis a transfer run crosses: the speed case or the headway.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Axis {
+pub(crate) enum Axis {
     SpeedCase,
     Headway,
 }
 
 impl Axis {
-    fn name(self) -> &'static str {
+    /// Both axes, speed case first.
+    pub(crate) const BOTH: [Axis; 2] = [Axis::SpeedCase, Axis::Headway];
+
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Axis::SpeedCase => "speed case",
             Axis::Headway => "headway",
         }
     }
 
-    fn label(self, row: &RunRow) -> String {
+    pub(crate) fn label(self, row: &RunRow) -> String {
         match self {
             Axis::SpeedCase => row.spec.speed_case.name.clone(),
             Axis::Headway => format!("{} m", row.spec.headway_m),
@@ -55,11 +58,6 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
     if !has(Experiment::Matrix) && !has(Experiment::Accumulation) {
         return;
     }
-    let grid: HashMap<CellKey, &RunRow> = rows
-        .iter()
-        .filter(|r| r.spec.experiment == Experiment::Grid)
-        .map(|r| (r.spec.experiment_cell(), r))
-        .collect();
     let _ = writeln!(out, "## Experience across scenes\n");
     let _ = writeln!(
         out,
@@ -69,8 +67,8 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
          were counted. A cell is *worse* when it needs more than one takeover more than from scratch.\n"
     );
     for &method in methods {
-        for axis in [Axis::SpeedCase, Axis::Headway] {
-            matrix(out, rows, &grid, method, axis);
+        for axis in Axis::BOTH {
+            matrix(out, rows, method, axis);
         }
     }
     for &method in methods {
@@ -78,17 +76,29 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
     }
 }
 
-/// One transfer matrix of `method` along `axis`, with its summary line.
-fn matrix(
-    out: &mut String,
-    rows: &[RunRow],
-    grid: &HashMap<CellKey, &RunRow>,
-    method: Method,
-    axis: Axis,
-) {
-    let mut labels: Vec<String> = Vec::new();
-    let mut cells: HashMap<(String, String), Vec<f64>> = HashMap::new();
-    let (mut with, mut without, mut worse, mut capped) = (Vec::new(), Vec::new(), 0, 0);
+/// One pair of the transfer matrix: a cell run from scratch and with the
+/// experience of another scene, both counted.
+pub(crate) struct MatrixPair {
+    /// The scene the experience came from.
+    pub from: String,
+    /// The cell's scene.
+    pub to: String,
+    /// Counted takeovers from scratch (the grid run).
+    pub without: f64,
+    /// Counted takeovers with the experience.
+    pub with: f64,
+    /// Whether the run with experience personalized.
+    pub personalized: bool,
+}
+
+/// The pairs of `method`'s transfer matrix along `axis`, in run order.
+pub(crate) fn matrix_pairs(rows: &[RunRow], method: Method, axis: Axis) -> Vec<MatrixPair> {
+    let grid: HashMap<CellKey, &RunRow> = rows
+        .iter()
+        .filter(|r| r.spec.experiment == Experiment::Grid)
+        .map(|r| (r.spec.experiment_cell(), r))
+        .collect();
+    let mut pairs = Vec::new();
     for row in rows.iter().filter(|r| {
         r.spec.experiment == Experiment::Matrix && r.spec.method == method && r.status.counted()
     }) {
@@ -104,19 +114,41 @@ fn matrix(
         if !base.status.counted() {
             continue;
         }
-        let (from, to) = (axis.label(source), axis.label(row));
+        pairs.push(MatrixPair {
+            from: axis.label(source),
+            to: axis.label(row),
+            without: base.counted_takeovers() as f64,
+            with: row.counted_takeovers() as f64,
+            personalized: row.personalized(),
+        });
+    }
+    pairs
+}
+
+/// One transfer matrix of `method` along `axis`, with its summary line.
+fn matrix(out: &mut String, rows: &[RunRow], method: Method, axis: Axis) {
+    let mut labels: Vec<String> = Vec::new();
+    let mut cells: HashMap<(String, String), Vec<f64>> = HashMap::new();
+    let (mut with, mut without, mut worse, mut capped) = (Vec::new(), Vec::new(), 0, 0);
+    for pair in matrix_pairs(rows, method, axis) {
+        let MatrixPair {
+            from,
+            to,
+            without: a,
+            with: b,
+            personalized,
+        } = pair;
         for label in [&from, &to] {
             if !labels.contains(label) {
                 labels.push(label.clone());
             }
         }
-        let (a, b) = (base.counted_takeovers(), row.counted_takeovers());
-        cells.entry((from, to.clone())).or_default().push(b as f64);
-        cells.entry((to.clone(), to)).or_default().push(a as f64);
-        with.push(b as f64);
-        without.push(a as f64);
-        worse += usize::from(b > a + 1);
-        capped += usize::from(!row.personalized());
+        cells.entry((from, to.clone())).or_default().push(b);
+        cells.entry((to.clone(), to)).or_default().push(a);
+        with.push(b);
+        without.push(a);
+        worse += usize::from(b > a + 1.0);
+        capped += usize::from(!personalized);
     }
     if with.is_empty() {
         return;
@@ -163,50 +195,8 @@ fn matrix(
 /// 1, from scratch); each later scene starts from the experience of the one
 /// before. A run counts when it and every run before it in its chain were counted.
 fn accumulation(out: &mut String, rows: &[RunRow], method: Method) {
-    let source = |r: &RunRow| r.spec.experience_from.and_then(|id| rows.get(id));
-    for axis in [Axis::SpeedCase, Axis::Headway] {
-        let chained: Vec<&RunRow> = rows
-            .iter()
-            .filter(|r| r.spec.experiment == Experiment::Accumulation && r.spec.method == method)
-            .filter(|r| source(r).is_some_and(|s| Axis::of(r, s) == axis))
-            .collect();
-        if chained.is_empty() {
-            continue;
-        }
-        // Per user kind, in order of appearance: takeovers by place.
-        let mut kinds: Vec<(String, Vec<Vec<f64>>)> = Vec::new();
-        let mut starts: Vec<usize> = Vec::new();
-        for row in chained {
-            let (mut place, mut counted, mut at) = (1, true, Some(row));
-            while let Some(run) = at.filter(|r| r.spec.experiment != Experiment::Grid) {
-                counted &= run.status.counted();
-                place += 1;
-                at = source(run);
-            }
-            let Some(start) = at.filter(|grid| grid.status.counted()) else {
-                continue;
-            };
-            if !counted {
-                continue;
-            }
-            let name = &row.spec.user.name;
-            let index = match kinds.iter().position(|(n, _)| n == name) {
-                Some(i) => i,
-                None => {
-                    kinds.push((name.clone(), vec![Vec::new()]));
-                    kinds.len() - 1
-                }
-            };
-            let places = &mut kinds[index].1;
-            if !starts.contains(&start.spec.id) {
-                starts.push(start.spec.id);
-                places[0].push(start.counted_takeovers() as f64);
-            }
-            if places.len() < place {
-                places.resize(place, Vec::new());
-            }
-            places[place - 1].push(row.counted_takeovers() as f64);
-        }
+    for axis in Axis::BOTH {
+        let kinds = accumulation_places(rows, method, axis);
         let scenes = kinds.iter().map(|(_, p)| p.len()).max().unwrap_or(0);
         if scenes < 2 {
             continue;
@@ -244,4 +234,54 @@ fn accumulation(out: &mut String, rows: &[RunRow], method: Method) {
         }
         let _ = writeln!(out);
     }
+}
+
+/// The accumulation chains of `method` along `axis`, per user kind in order of
+/// appearance: the counted takeovers at each place of the chain (place 0 is the
+/// grid run the chain starts from). A run counts when it and every run before it
+/// in its chain were counted.
+pub(crate) fn accumulation_places(
+    rows: &[RunRow],
+    method: Method,
+    axis: Axis,
+) -> Vec<(String, Vec<Vec<f64>>)> {
+    let source = |r: &RunRow| r.spec.experience_from.and_then(|id| rows.get(id));
+    let chained = rows
+        .iter()
+        .filter(|r| r.spec.experiment == Experiment::Accumulation && r.spec.method == method)
+        .filter(|r| source(r).is_some_and(|s| Axis::of(r, s) == axis));
+    let mut kinds: Vec<(String, Vec<Vec<f64>>)> = Vec::new();
+    let mut starts: Vec<usize> = Vec::new();
+    for row in chained {
+        let (mut place, mut counted, mut at) = (1, true, Some(row));
+        while let Some(run) = at.filter(|r| r.spec.experiment != Experiment::Grid) {
+            counted &= run.status.counted();
+            place += 1;
+            at = source(run);
+        }
+        let Some(start) = at.filter(|grid| grid.status.counted()) else {
+            continue;
+        };
+        if !counted {
+            continue;
+        }
+        let name = &row.spec.user.name;
+        let index = match kinds.iter().position(|(n, _)| n == name) {
+            Some(i) => i,
+            None => {
+                kinds.push((name.clone(), vec![Vec::new()]));
+                kinds.len() - 1
+            }
+        };
+        let places = &mut kinds[index].1;
+        if !starts.contains(&start.spec.id) {
+            starts.push(start.spec.id);
+            places[0].push(start.counted_takeovers() as f64);
+        }
+        if places.len() < place {
+            places.resize(place, Vec::new());
+        }
+        places[place - 1].push(row.counted_takeovers() as f64);
+    }
+    kinds
 }
