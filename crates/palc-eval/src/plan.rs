@@ -8,7 +8,7 @@ use palc_traffic::{SpeedCaseConfig, TestbedConfig};
 use serde::{Deserialize, Serialize};
 
 use crate::EvalError;
-use crate::config::{Selection, TransferSource, UserKind, speed_case};
+use crate::config::{Grid, Selection, TransferSource, UserKind, speed_case};
 
 /// The experiment a run belongs to.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -161,28 +161,7 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
     let mut first = Vec::new();
     for method in &grid.methods {
         for user in &selection.users {
-            for case in &grid.speed_cases {
-                for &headway_m in &grid.headways_m {
-                    for style in &grid.styles {
-                        for &seed in &grid.seeds {
-                            first.push(RunSpec {
-                                id: first.len(),
-                                experiment: Experiment::Grid,
-                                method: *method,
-                                user: user.clone(),
-                                style: *style,
-                                speed_case: case.clone(),
-                                headway_m,
-                                seed,
-                                dt: None,
-                                horizon_margin_s: None,
-                                experience_from: None,
-                                rung: None,
-                            });
-                        }
-                    }
-                }
-            }
+            grid_cells(&mut first, grid, Experiment::Grid, *method, user, None);
         }
     }
     let timing = &selection.timing;
@@ -228,28 +207,15 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
     for rung in &rungs {
         for user in (selection.users.iter()).filter(|u| selection.ablation.users.contains(&u.name))
         {
-            for case in &grid.speed_cases {
-                for &headway_m in &grid.headways_m {
-                    for style in &grid.styles {
-                        for &seed in &grid.seeds {
-                            first.push(RunSpec {
-                                id: first.len(),
-                                experiment: Experiment::Ablation,
-                                method: rung.labels,
-                                user: user.clone(),
-                                style: *style,
-                                speed_case: case.clone(),
-                                headway_m,
-                                seed,
-                                dt: None,
-                                horizon_margin_s: None,
-                                experience_from: None,
-                                rung: Some(rung.name.clone()),
-                            });
-                        }
-                    }
-                }
-            }
+            let name = Some(rung.name.clone());
+            grid_cells(
+                &mut first,
+                grid,
+                Experiment::Ablation,
+                rung.labels,
+                user,
+                name,
+            );
         }
     }
     let mut transfer = Vec::new();
@@ -359,6 +325,40 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
         }
     }
     Ok(RunPlan { first, transfer })
+}
+
+/// Appends a run of `experiment` for every cell of `grid` (speed case x headway x
+/// style x seed, in that order) with this method, user and rung.
+fn grid_cells(
+    runs: &mut Vec<RunSpec>,
+    grid: &Grid,
+    experiment: Experiment,
+    method: Method,
+    user: &UserKind,
+    rung: Option<String>,
+) {
+    for case in &grid.speed_cases {
+        for &headway_m in &grid.headways_m {
+            for style in &grid.styles {
+                for &seed in &grid.seeds {
+                    runs.push(RunSpec {
+                        id: runs.len(),
+                        experiment,
+                        method,
+                        user: user.clone(),
+                        style: *style,
+                        speed_case: case.clone(),
+                        headway_m,
+                        seed,
+                        dt: None,
+                        horizon_margin_s: None,
+                        experience_from: None,
+                        rung: rung.clone(),
+                    });
+                }
+            }
+        }
+    }
 }
 
 /// The phase-one run (of `target`'s experiment and rung) whose experience
