@@ -147,6 +147,16 @@ impl Observer for Printer {
                 summary.learning_failures
             );
         }
+        if let Some(frozen) = summary.frozen {
+            say!(
+                "after learning, frozen: {} of {} lane changes taken over ({:.0} %), the nominal plan {} ({:.0} %)",
+                frozen.takeovers,
+                frozen.lane_changes,
+                100.0 * frozen.takeover_rate(),
+                frozen.ceiling_takeovers,
+                100.0 * frozen.ceiling_rate()
+            );
+        }
     }
 }
 
