@@ -39,6 +39,8 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
         Experiment::ClosedLoop,
         Experiment::Matrix,
         Experiment::Accumulation,
+        Experiment::Ablation,
+        Experiment::AblationTransfer,
     ] {
         for &method in methods {
             let iterations: Vec<&Iteration> = rows
@@ -54,11 +56,17 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
                 let values: Vec<f64> = iterations.iter().filter_map(|i| f(&i.safety)).collect();
                 low_tail(values)
             };
+            // An ablation run's method is its rung's label rule: every such rung.
+            let who = match experiment {
+                Experiment::Ablation | Experiment::AblationTransfer => {
+                    format!("rungs with `{}` labels", method.name())
+                }
+                _ => format!("`{}`", method.name()),
+            };
             let _ = writeln!(
                 out,
-                "| {} | `{}` | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                "| {} | {who} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                 experiment.name(),
-                method.name(),
                 iterations.len(),
                 count(&|i| i.safety.collision),
                 count(&|i| i.safety.rss_violations > 0),
