@@ -103,7 +103,6 @@ impl RewardCorrection for IncrementalRule {
         let first = plan(input.weights)?;
         let before = error(&first.features);
         let mut best_weights = input.weights.clone();
-        let mut best_features = first.features.clone();
         let mut best_plan = first;
         let mut best_error = before;
         let mut alpha = self.step_size;
@@ -116,7 +115,7 @@ impl RewardCorrection for IncrementalRule {
             let columns: Vec<[f64; FEATURE_COUNT]> = best_weights
                 .columns()
                 .iter()
-                .zip(best_features.columns())
+                .zip(best_plan.features.columns())
                 .zip(input.expert.columns())
                 .map(|((w, p), e)| {
                     let mut next = *w;
@@ -139,7 +138,6 @@ impl RewardCorrection for IncrementalRule {
                 Ok(p) if error(&p.features) < best_error => {
                     best_error = error(&p.features);
                     best_weights = candidate;
-                    best_features = p.features.clone();
                     best_plan = p;
                 }
                 _ => {

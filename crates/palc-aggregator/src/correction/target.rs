@@ -109,13 +109,12 @@ impl RewardCorrection for TargetRule {
         let first = plan(input.weights)?;
         let before = scaled(&first.features);
         let mut best_weights = input.weights.clone();
-        let mut best_features = first.features.clone();
         let mut best_plan = first;
-        let mut best_error = lateral_error(&best_features, input.expert);
+        let mut best_error = lateral_error(&best_plan.features, input.expert);
         let mut gain = self.gain;
         let mut solves = 1;
         while solves <= self.max_inner_solves && best_error > self.tolerance_m {
-            let planned: Vec<f64> = best_features.row(feature::L).collect();
+            let planned: Vec<f64> = best_plan.features.row(feature::L).collect();
             let expert: Vec<f64> = input.expert.row(feature::L).collect();
             let columns = (best_weights.columns().iter().enumerate())
                 .map(|(c, w)| {
@@ -139,14 +138,13 @@ impl RewardCorrection for TargetRule {
                 Ok(p) if lateral_error(&p.features, input.expert) < best_error => {
                     best_error = lateral_error(&p.features, input.expert);
                     best_weights = candidate;
-                    best_features = p.features.clone();
                     best_plan = p;
                 }
                 _ => gain *= 0.5,
             }
         }
         Ok(CorrectionOutcome {
-            error_after: scaled(&best_features),
+            error_after: scaled(&best_plan.features),
             weights: best_weights,
             apprenticeship: state.cloned(),
             error_before: before,
