@@ -3,7 +3,9 @@
 //!
 //! xtask only orchestrates: `reproduce-paper` runs the product's own command,
 //! `palc eval`, in a release build, so the evaluation lives in one place
-//! (`crates/palc-eval`) and the task and the command give the same outputs.
+//! (`crates/palc-eval`) and the task and the command give the same outputs: the
+//! paper's set-up (`configs/reproduce.toml`), then the same with the ACC and the
+//! safety layer (`configs/reproduce-safe.toml`, into `safe/`).
 //! Repository hygiene lives in `tidy.rs` as ordinary tests, run by
 //! `cargo test --workspace`.
 
@@ -38,13 +40,53 @@ fn print_help() {
     println!(
         "cargo xtask <task>\n\ntasks:\n  \
          reproduce-paper  regenerate the paper's evaluation (--quick, --jobs N, --out DIR, --config FILE);\n                   \
-         the same as `palc eval` in a release build\n  \
+         the same as `palc eval` in a release build, then (without --config)\n                   \
+         configs/reproduce-safe.toml into DIR/safe\n  \
          help             this text"
     );
 }
 
-/// `cargo xtask reproduce-paper [flags]`: `palc eval [flags]`, built in release mode.
+/// `cargo xtask reproduce-paper [flags]`: `palc eval [flags]`, built in release mode;
+/// without `--config`, also the same evaluation with the ego's ACC, the safety layer
+/// and users who wait for safe gaps (`configs/reproduce-safe.toml`), written to
+/// `safe/` under the output directory.
 fn reproduce_paper(args: impl Iterator<Item = String>) -> anyhow::Result<()> {
+    let args: Vec<String> = args.collect();
+    palc_eval(&args)?;
+    if args
+        .iter()
+        .any(|a| a == "--config" || a.starts_with("--config="))
+    {
+        return Ok(());
+    }
+    let mut out = PathBuf::from(DEFAULT_OUT);
+    let mut safe = Vec::new();
+    let mut rest = args.iter();
+    while let Some(arg) = rest.next() {
+        if arg == "--out" {
+            out = rest.next().map_or(out, PathBuf::from);
+        } else if let Some(dir) = arg.strip_prefix("--out=") {
+            out = PathBuf::from(dir);
+        } else {
+            safe.push(arg.clone());
+        }
+    }
+    safe.extend([
+        "--config".to_owned(),
+        SAFE_CONFIG.to_owned(),
+        "--out".to_owned(),
+        out.join("safe").display().to_string(),
+    ]);
+    palc_eval(&safe)
+}
+
+/// `palc eval`'s default output directory.
+const DEFAULT_OUT: &str = "target/reproduce-paper";
+/// The evaluation with the ACC, the safety layer and users who wait for safe gaps.
+const SAFE_CONFIG: &str = "configs/reproduce-safe.toml";
+
+/// `palc eval ARGS` in a release build.
+fn palc_eval(args: &[String]) -> anyhow::Result<()> {
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let status = Command::new(cargo)
         .args([

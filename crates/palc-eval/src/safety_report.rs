@@ -22,7 +22,11 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
          `[planning.safety]`). *System* counts the steps the system drove (the plan up to a \
          takeover); *user* the steps the simulated user drove after a takeover. The safety layer \
          checks every plan before it is driven and drives the standard ALC's plan instead of an \
-         unsafe one (a refusal).\n"
+         unsafe one (a refusal), when the config turns it on (`planning.safety.enforce`). The \
+         paper's set-up holds every speed constant and has no safety layer; \
+         `configs/reproduce-safe.toml` is the same evaluation with the ego's ACC, the safety layer \
+         and users who start only into gaps at the safe distance (`cargo xtask reproduce-paper` \
+         writes its report to `safe/REPORT.md`).\n"
     );
     let _ = writeln!(
         out,

@@ -39,6 +39,13 @@ pub struct SafetyConfig {
     /// lane change keeps the RSS distance to it (docs/paper-mapping.md, "Safety").
     /// The measures are taken either way.
     pub enforce: bool,
+    /// Whether the simulated users of this configuration start their lane change
+    /// only into target-lane gaps at least the safe distance below, at every step
+    /// of their lane change as the traffic's motion shows it (the lane-keeping
+    /// prediction), besides their style's own gap acceptance: users whose
+    /// preferred lane change is safe. Off by default: the paper's users accept any
+    /// positive gap behind them (docs/paper-mapping.md, "Safety").
+    pub users_wait_for_safe_gaps: bool,
     /// Response time `ρ` of the rear vehicle (s).
     pub response_time_s: f64,
     /// Largest acceleration `a_acc` of the rear vehicle during its response (m/s²).
@@ -56,6 +63,7 @@ impl Default for SafetyConfig {
     fn default() -> Self {
         Self {
             enforce: false,
+            users_wait_for_safe_gaps: false,
             response_time_s: 0.5,
             max_acceleration_mps2: 1.5,
             min_braking_mps2: 6.0,

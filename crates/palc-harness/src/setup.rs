@@ -412,7 +412,7 @@ impl Setup {
 
 /// Whether both target-lane gaps in `situation` are at least the safe distance:
 /// the ego behind the lead, the lag behind the ego.
-fn target_gaps_safe(situation: &Situation, safety: &SafetyConfig) -> bool {
+pub(crate) fn target_gaps_safe(situation: &Situation, safety: &SafetyConfig) -> bool {
     let v = situation.ego_speed;
     let lead_ok = match (situation.target_lead_gap_m, situation.target_lead_speed) {
         (Some(gap), Some(lead_v)) => gap >= safety.safe_distance(v, lead_v),

@@ -252,3 +252,60 @@ fn with_the_safety_layer_on_no_driven_plan_is_unsafe_and_every_refusal_is_record
     assert!(seen > 0);
     let _ = NoObserver;
 }
+
+#[test]
+fn users_who_wait_for_safe_gaps_start_at_the_safe_distance_and_never_earlier() {
+    use palc_harness::{CellChoice, LearnConfig, StylePreset, UserConfig, expectation};
+
+    let text = include_str!("../../../configs/learn-safe.toml");
+    let base = LearnConfig::from_toml_str(text).expect("the safe config parses");
+    assert!(base.planning.safety.users_wait_for_safe_gaps);
+    let safety = base.planning.safety;
+    let (mut compared, mut later) = (0, 0);
+    for speed_case in [
+        "collector-high",
+        "collector-slow",
+        "arterial-high",
+        "arterial-slow",
+    ] {
+        for headway_m in [50.0, 40.0] {
+            for style in StylePreset::ALL {
+                let waiting = (base.clone())
+                    .with_cell(CellChoice {
+                        speed_case: speed_case.into(),
+                        headway_m,
+                        seed: 1,
+                    })
+                    .with_user(UserConfig::preset(style));
+                let mut paper = waiting.clone();
+                paper.planning.safety.users_wait_for_safe_gaps = false;
+                let Ok((setup, expected)) = expectation(&waiting) else {
+                    continue;
+                };
+                let s = &setup.situations[expected.start_step];
+                let v = s.ego_speed;
+                if let (Some(gap), Some(lead_v)) = (s.target_lead_gap_m, s.target_lead_speed) {
+                    assert!(
+                        gap >= safety.safe_distance(v, lead_v),
+                        "{speed_case} {style:?}"
+                    );
+                }
+                if let (Some(gap), Some(lag_v)) = (s.target_lag_gap_m, s.target_lag_speed) {
+                    assert!(
+                        gap >= safety.safe_distance(lag_v, v),
+                        "{speed_case} {style:?}"
+                    );
+                }
+                // Waiting only adds a condition: never an earlier start.
+                let Ok((_, unsafe_start)) = expectation(&paper) else {
+                    continue;
+                };
+                assert!(expected.start_step >= unsafe_start.start_step);
+                compared += 1;
+                later += usize::from(expected.start_step > unsafe_start.start_step);
+            }
+        }
+    }
+    assert!(compared >= 12, "{compared} cells compared");
+    assert!(later > 0, "the condition never held a user back");
+}

@@ -122,9 +122,12 @@ pub struct PlannerConfig {
     pub dt: f64,
     /// Distance `l_fr` between the front and rear axles (m).
     pub wheelbase: f64,
-    /// Weight `ρ_a` of the extra cost `ρ_a Σ a_i²` (m⁻² s⁴). The printed cost leaves the
-    /// acceleration free, which makes the optimum non-unique and, with `w9` or `w10`
-    /// non-zero, absurd; see docs/paper-mapping.md.
+    /// Weight `ρ_a` of the extra cost `ρ_a Σ (a_i - a_i^ref)²` (m⁻² s⁴), `a^ref` the
+    /// acceleration of the problem's reference speed profile
+    /// ([`Problem::reference_acceleration`](crate::Problem::reference_acceleration); 0 at
+    /// constant speed). The printed cost leaves the acceleration free, which makes the
+    /// optimum non-unique and, with `w9` or `w10` non-zero, absurd; see
+    /// docs/paper-mapping.md.
     pub acceleration_penalty: f64,
     /// Lowest front wheel angle `δ_min` (rad) of Eq. (23).
     pub steering_min: f64,

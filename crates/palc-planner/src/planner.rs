@@ -272,8 +272,11 @@ impl Planner {
         controls: &[Control],
         violation: &[f64],
     ) -> Extras {
-        let acceleration =
-            self.config.acceleration_penalty * controls.iter().map(|u| u.a * u.a).sum::<f64>();
+        let dt = self.config.dt;
+        let acceleration = self.config.acceleration_penalty
+            * (controls.iter().enumerate())
+                .map(|(i, u)| (u.a - problem.reference_acceleration(i, dt)).powi(2))
+                .sum::<f64>();
         let tracking = problem.tracking.as_ref().map_or(0.0, |t| {
             states
                 .iter()

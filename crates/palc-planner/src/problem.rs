@@ -134,7 +134,9 @@ pub struct Problem {
     /// `X_0` of Eq. (20).
     pub initial: State,
     /// Speed profile `v_i^ref` for `i = 0..K-1` (length `K`) around which the lateral
-    /// dynamics are linearized (Eqs. 12-14); must be `>= 0`.
+    /// dynamics are linearized (Eqs. 12-14); must be `>= 0`. It is also the intended
+    /// longitudinal motion: the acceleration penalty acts on `a_i - a_i^ref`, with
+    /// `a^ref` the profile's own acceleration ([`Problem::reference_acceleration`]).
     pub reference_speed: Vec<f64>,
     /// Road curvature `R` (1/m) of Eq. (14); 0 on a straight road.
     #[cfg_attr(feature = "serde", serde(default))]
@@ -152,4 +154,21 @@ pub struct Problem {
     /// Optional tracking term (form of Eq. 25).
     #[cfg_attr(feature = "serde", serde(default))]
     pub tracking: Option<Tracking>,
+}
+
+impl Problem {
+    /// The acceleration of the reference speed profile at control `i` (m/s²): the
+    /// forward difference `(v_{i+1}^ref - v_i^ref) / Δt`, towards the terminal speed
+    /// at the last step; 0 for a constant profile that ends at its own speed.
+    ///
+    /// The acceleration penalty of [`PlannerConfig`](crate::PlannerConfig) is
+    /// `ρ_a Σ_i (a_i - a_i^ref)²`, so a plan follows the reference longitudinal motion
+    /// (e.g. an ACC's speed while the ego keeps its lane) except where the learned cost
+    /// (`w7`, `w9`, `w10`) asks otherwise; the paper's constant speeds give `a^ref = 0`
+    /// and the penalty of Eq. (34)'s repair, `ρ_a Σ a_i²`.
+    pub fn reference_acceleration(&self, i: usize, dt: f64) -> f64 {
+        let here = self.reference_speed.get(i).copied().unwrap_or(0.0);
+        let next = (self.reference_speed.get(i + 1).copied()).unwrap_or(self.terminal.v);
+        (next - here) / dt
+    }
 }

@@ -7,8 +7,8 @@
 //! ```
 //!
 //! with `ux_i = [X_i; U_i]`: per step a 6 x 6 cost block (the quadratic features of
-//! Eq. 34 weighted by column `i` of `w`, the acceleration penalty and the tracking
-//! term), the affine dynamics, the fixed `X_0`, the terminal rows, and inequality rows
+//! Eq. 34 weighted by column `i` of `w`, the acceleration penalty around the reference
+//! profile's acceleration ([`Problem::reference_acceleration`]) and the tracking term), the affine dynamics, the fixed `X_0`, the terminal rows, and inequality rows
 //! that each touch one stage variable and at most one soft-bound slack `σ`.
 //!
 //! This is the one assembly: the Riccati backend reads it as it is, and the clarabel
@@ -193,6 +193,8 @@ impl StageQp {
             h[(S, S)] += 2.0 * (w9 + w10);
             h[(L, L)] += 2.0 * (w[feature::L_SQUARED] + w9 + w10);
             h[(PHI, PHI)] += 2.0 * w[feature::PHI_SQUARED];
+            // ρ_a (a - a_ref)² = ρ_a a² - 2 ρ_a a_ref a + ρ_a a_ref².
+            let a_ref = problem.reference_acceleration(stage, dt);
             h[(A, A)] += 2.0 * config.acceleration_penalty;
             h[(DELTA, DELTA)] += 2.0 * w[feature::DELTA_SQUARED];
             for (row, weight) in [
@@ -208,8 +210,10 @@ impl StageQp {
             g[L] += w[feature::L] - 2.0 * (w9 * pre.l + w10 * adj.l);
             g[PHI] += w[feature::PHI];
             g[DELTA] += w[feature::S_DELTA] * origin;
-            self.constant +=
-                w9 * (pre.s * pre.s + pre.l * pre.l) + w10 * (adj.s * adj.s + adj.l * adj.l);
+            g[A] += -2.0 * config.acceleration_penalty * a_ref;
+            self.constant += config.acceleration_penalty * a_ref * a_ref
+                + w9 * (pre.s * pre.s + pre.l * pre.l)
+                + w10 * (adj.s * adj.s + adj.l * adj.l);
         }
         // Tracking (form of Eq. 25).
         if let Some(tracking) = &problem.tracking {

@@ -4,7 +4,7 @@
 mod common;
 
 use common::lane_change;
-use palc_planner::{LateralBound, LateralBoundsMode, Planner, PlannerConfig, Tracking};
+use palc_planner::{LateralBound, LateralBoundsMode, Planner, PlannerConfig, Tracking, feature};
 use proptest::prelude::*;
 
 proptest! {
@@ -86,4 +86,45 @@ fn strong_tracking_reproduces_a_feasible_reference() {
         .sum();
     let total = plan.learned_cost + plan.extras.total();
     assert!((plan.objective - total).abs() <= 1e-12 * (1.0 + constant));
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(16))]
+
+    /// The acceleration penalty acts around the reference profile's own acceleration:
+    /// without a learned longitudinal term (`w7`, `w9`, `w10` zero), a plan whose
+    /// terminal speed and station are the reference's follows the reference speed
+    /// profile, whatever its shape (an ACC slowing down behind a vehicle, say).
+    #[test]
+    fn without_longitudinal_terms_the_plan_follows_the_reference_speed(
+        start in 12.0..30.0f64,
+        change in -6.0..6.0f64,
+        bend in 0.0..1.0f64,
+    ) {
+        let config = PlannerConfig { horizon: 60, dt: 0.1, ..PlannerConfig::default() };
+        let (k, dt) = (config.horizon, config.dt);
+        let mut problem = lane_change(&config, start);
+        for column in problem.weights.columns_mut() {
+            column[feature::S_DELTA] = 0.0;
+            column[feature::DIST_PRECEDING] = 0.0;
+            column[feature::DIST_ADJACENT] = 0.0;
+        }
+        // A speed profile from `start` to `start + change`, eased by `bend`.
+        let speed = |i: usize| {
+            let x = i as f64 / k as f64;
+            start + change * ((1.0 - bend) * x + bend * x * x)
+        };
+        problem.reference_speed = (0..k).map(speed).collect();
+        // The forward-Euler station the profile reaches, as the plan's dynamics has it.
+        let station: f64 = (0..k).map(|i| speed(i) * dt).sum();
+        problem.terminal.v = speed(k);
+        problem.terminal.s = Some(station);
+        let plan = Planner::new(config.clone()).unwrap().plan(&problem).unwrap();
+        for i in 0..k {
+            let a_ref = problem.reference_acceleration(i, dt);
+            prop_assert!((plan.controls[i].a - a_ref).abs() < 1e-4, "step {i}");
+            prop_assert!((plan.states[i].v - speed(i)).abs() < 1e-4, "step {i}");
+        }
+        prop_assert!(plan.extras.acceleration < 1e-6, "{}", plan.extras.acceleration);
+    }
 }

@@ -5,7 +5,7 @@ use palc_planner::State;
 use rand_chacha::ChaCha8Rng;
 
 use crate::HarnessError;
-use crate::setup::Setup;
+use crate::setup::{Setup, target_gaps_safe};
 use crate::user::User;
 use crate::user::expectation::{
     Expectation, ExpectedLaneChange, MAX_LATERAL_ACCELERATION_MPS2, MAX_LATERAL_JERK_MPS3,
@@ -124,19 +124,31 @@ impl SimulatedUser {
         // that is a multiple of the step up to rounding).
         let reaction_steps = (family.reaction_s / dt - 1e-9).ceil().max(0.0) as usize;
         let earliest = decision_step + reaction_steps;
-        let start_step = (earliest..=window)
-            .find(|&i| accepting.accepts(&situations[i]))
-            .ok_or_else(|| {
-                refuse(format!(
-                    "the target lane's gaps never become acceptable to it (lead {:.2} s, lag \
-                     {:.2} s) within the search window after its decision at step {decision_step}",
-                    accepting.min_lead_gap_s, accepting.min_lag_gap_s
-                ))
-            })?;
         let duration_s = family
             .profile
             .own_duration_s()
             .unwrap_or(style.lane_change_duration_s);
+        // With `users_wait_for_safe_gaps`, the gaps must also be at the RSS safe
+        // distance when the lane change starts (the follower then brakes for the ego,
+        // as RSS's responsibility rule assumes).
+        let safety = &setup.safety;
+        let safe =
+            |i: usize| !safety.users_wait_for_safe_gaps || target_gaps_safe(&situations[i], safety);
+        let start_step = (earliest..=window)
+            .find(|&i| accepting.accepts(&situations[i]) && safe(i))
+            .ok_or_else(|| {
+                refuse(format!(
+                    "the target lane's gaps never become acceptable to it (lead {:.2} s, lag \
+                     {:.2} s{}) within the search window after its decision at step {decision_step}",
+                    accepting.min_lead_gap_s,
+                    accepting.min_lag_gap_s,
+                    if safety.users_wait_for_safe_gaps {
+                        ", and the RSS safe distance"
+                    } else {
+                        ""
+                    }
+                ))
+            })?;
         let lane_change = ExpectedLaneChange {
             start_s: start_step as f64 * dt,
             duration_s,

@@ -110,7 +110,14 @@ pub fn cost(
 ) -> f64 {
     let phi = features(states, controls, &problem.preceding, &problem.adjacent).unwrap();
     let mut total = problem.weights.dot(&phi).unwrap();
-    total += config.acceleration_penalty * controls.iter().map(|u| u.a * u.a).sum::<f64>();
+    // The penalty acts around the reference profile's own acceleration (forward
+    // differences, towards the terminal speed at the last step).
+    let v_ref = &problem.reference_speed;
+    for (i, u) in controls.iter().enumerate() {
+        let next = v_ref.get(i + 1).copied().unwrap_or(problem.terminal.v);
+        let a_ref = (next - v_ref[i]) / config.dt;
+        total += config.acceleration_penalty * (u.a - a_ref).powi(2);
+    }
     if let Some(t) = &problem.tracking {
         for (x, r) in states.iter().zip(&t.reference) {
             if let Some(r) = r {
