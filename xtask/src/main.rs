@@ -5,7 +5,8 @@
 //! `palc eval`, in a release build, so the evaluation lives in one place
 //! (`crates/palc-eval`) and the task and the command give the same outputs: the
 //! paper's set-up (`configs/reproduce.toml`), then the same with the ACC and the
-//! safety layer (`configs/reproduce-safe.toml`, into `safe/`).
+//! safety layer (`configs/reproduce-safe.toml`, into `safe/`) and the stress scenes
+//! (`configs/stress/`, into `stress/<scene>/`).
 //! Repository hygiene lives in `tidy.rs` as ordinary tests, run by
 //! `cargo test --workspace`.
 
@@ -41,15 +42,15 @@ fn print_help() {
         "cargo xtask <task>\n\ntasks:\n  \
          reproduce-paper  regenerate the paper's evaluation (--quick, --jobs N, --out DIR, --config FILE);\n                   \
          the same as `palc eval` in a release build, then (without --config)\n                   \
-         configs/reproduce-safe.toml into DIR/safe\n  \
+         configs/reproduce-safe.toml into DIR/safe and configs/stress/* into DIR/stress\n  \
          help             this text"
     );
 }
 
 /// `cargo xtask reproduce-paper [flags]`: `palc eval [flags]`, built in release mode;
-/// without `--config`, also the same evaluation with the ego's ACC, the safety layer
-/// and users who wait for safe gaps (`configs/reproduce-safe.toml`), written to
-/// `safe/` under the output directory.
+/// without `--config`, then the same evaluation with the ego's ACC, the safety layer
+/// and users who wait for safe gaps, and the stress scenes under the same set-up
+/// ([`COMPANIONS`]), each written to its directory under the output directory.
 fn reproduce_paper(args: impl Iterator<Item = String>) -> anyhow::Result<()> {
     let args: Vec<String> = args.collect();
     palc_eval(&args)?;
@@ -60,7 +61,7 @@ fn reproduce_paper(args: impl Iterator<Item = String>) -> anyhow::Result<()> {
         return Ok(());
     }
     let mut out = PathBuf::from(DEFAULT_OUT);
-    let mut safe = Vec::new();
+    let mut rest_args = Vec::new();
     let mut rest = args.iter();
     while let Some(arg) = rest.next() {
         if arg == "--out" {
@@ -68,22 +69,40 @@ fn reproduce_paper(args: impl Iterator<Item = String>) -> anyhow::Result<()> {
         } else if let Some(dir) = arg.strip_prefix("--out=") {
             out = PathBuf::from(dir);
         } else {
-            safe.push(arg.clone());
+            rest_args.push(arg.clone());
         }
     }
-    safe.extend([
-        "--config".to_owned(),
-        SAFE_CONFIG.to_owned(),
-        "--out".to_owned(),
-        out.join("safe").display().to_string(),
-    ]);
-    palc_eval(&safe)
+    for (config, dir) in COMPANIONS {
+        let mut companion = rest_args.clone();
+        companion.extend([
+            "--config".to_owned(),
+            config.to_owned(),
+            "--out".to_owned(),
+            out.join(dir).display().to_string(),
+        ]);
+        palc_eval(&companion)?;
+    }
+    Ok(())
 }
 
 /// `palc eval`'s default output directory.
 const DEFAULT_OUT: &str = "target/reproduce-paper";
-/// The evaluation with the ACC, the safety layer and users who wait for safe gaps.
-const SAFE_CONFIG: &str = "configs/reproduce-safe.toml";
+
+/// The evaluations run after the paper's set-up, and their directories under the
+/// output directory: the ego's ACC, the safety layer and users who wait for safe
+/// gaps, then the stress scenes under the same set-up.
+const COMPANIONS: [(&str, &str); 4] = [
+    ("configs/reproduce-safe.toml", "safe"),
+    (
+        "configs/stress/braking-leader-eval.toml",
+        "stress/braking-leader",
+    ),
+    (
+        "configs/stress/accelerating-lag-eval.toml",
+        "stress/accelerating-lag",
+    ),
+    ("configs/stress/dense-eval.toml", "stress/dense"),
+];
 
 /// `palc eval ARGS` in a release build.
 fn palc_eval(args: &[String]) -> anyhow::Result<()> {

@@ -26,7 +26,8 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
          paper's set-up holds every speed constant and has no safety layer; \
          `configs/reproduce-safe.toml` is the same evaluation with the ego's ACC, the safety layer \
          and users who start only into gaps at the safe distance (`cargo xtask reproduce-paper` \
-         writes its report to `safe/REPORT.md`).\n"
+         writes its report to `safe/REPORT.md`, and the stress scenes of `configs/stress/` under \
+         the same set-up to `stress/`).\n"
     );
     let _ = writeln!(
         out,
