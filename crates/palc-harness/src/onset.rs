@@ -19,7 +19,7 @@
 
 use palc_aggregator::Onset;
 
-use crate::setup::Setup;
+use crate::setup::{Setup, target_gaps_safe};
 use crate::user::Situation;
 
 /// The lower fraction of the lane change whose crossing anchors the fit: low
@@ -296,9 +296,12 @@ pub(crate) fn predicted_start_s(setup: &Setup, onsets: &[Onset]) -> Option<f64> 
     let decides = |s: &Situation| {
         s.time_headway_s > 0.0 && feature.of_situation(s).is_some_and(|x| x <= threshold)
     };
+    // Under the safety layer a start below the safe distance would be refused.
+    let safety = &setup.safety;
     let accepts = |s: &Situation| {
         lead_time_gap(s).is_none_or(|g| g > 0.0 && g >= lead)
             && lag_time_gap(s).is_none_or(|g| g > 0.0 && g >= lag)
+            && (!safety.enforce || target_gaps_safe(s, safety))
     };
     let decided = situations.iter().position(decides)?;
     let start = decided + situations[decided..].iter().position(accepts)?;

@@ -102,3 +102,41 @@ fn relative_onset_transfers_better_than_time_indexing() {
         "relative onset {relative_sum}, time-indexed {time_indexed_sum} (three styles)"
     );
 }
+
+#[test]
+fn under_the_safety_layer_the_predicted_start_waits_for_a_safe_gap() {
+    // With the ACC and the safety layer (configs/learn-safe.toml), a start below the
+    // safe distance would be refused, and the users wait for the safe distance too:
+    // the prediction of a carried experience skips such steps.
+    let text = include_str!("../../../configs/learn-safe.toml");
+    let base = LearnConfig::from_toml_str(text).expect("the safe config parses");
+    assert!(base.planning.safety.enforce);
+    let safe_cell = |speed_case: &str, style| {
+        (base.clone())
+            .with_cell(CellChoice {
+                speed_case: speed_case.into(),
+                headway_m: 40.0,
+                seed: 1,
+            })
+            .with_user(UserConfig::preset(style))
+    };
+    for style in StylePreset::ALL {
+        let learned = run(&safe_cell("collector-slow", style), None, &mut NoObserver)
+            .expect("the source run completes");
+        let target = safe_cell("collector-high", style);
+        let carried = LearningLoop::new(&target, Some(&learned.experience))
+            .expect("the target scenario prepares");
+        let anchor = (carried.experience().anchor_s).expect("the start is predicted");
+        let (setup, nominal) = expectation(&target).expect("the scenario is sane");
+        let s = &setup.situations[(anchor / setup.dt).round() as usize];
+        let safety = &target.planning.safety;
+        if let (Some(gap), Some(lag_v)) = (s.target_lag_gap_m, s.target_lag_speed) {
+            assert!(gap >= safety.safe_distance(lag_v, s.ego_speed), "{style:?}");
+        }
+        let truth = nominal.lane_change.start_s;
+        assert!(
+            (anchor - truth).abs() <= target.planning.dt + 1e-9,
+            "{style:?}: predicted {anchor} s, the user starts at {truth} s"
+        );
+    }
+}
