@@ -159,7 +159,8 @@ pub struct Problem {
 impl Problem {
     /// The acceleration of the reference speed profile at control `i` (m/s²): the
     /// forward difference `(v_{i+1}^ref - v_i^ref) / Δt`, towards the terminal speed
-    /// at the last step; 0 for a constant profile that ends at its own speed.
+    /// at the last step; 0 for a constant profile that ends at its own speed, and past
+    /// the horizon.
     ///
     /// The acceleration penalty of [`PlannerConfig`](crate::PlannerConfig) is
     /// `ρ_a Σ_i (a_i - a_i^ref)²`, so a plan follows the reference longitudinal motion
@@ -167,7 +168,9 @@ impl Problem {
     /// (`w7`, `w9`, `w10`) asks otherwise; the paper's constant speeds give `a^ref = 0`
     /// and the penalty of Eq. (34)'s repair, `ρ_a Σ a_i²`.
     pub fn reference_acceleration(&self, i: usize, dt: f64) -> f64 {
-        let here = self.reference_speed.get(i).copied().unwrap_or(0.0);
+        let Some(&here) = self.reference_speed.get(i) else {
+            return 0.0;
+        };
         let next = (self.reference_speed.get(i + 1).copied()).unwrap_or(self.terminal.v);
         (next - here) / dt
     }

@@ -8,7 +8,8 @@
 //!
 //! with `ux_i = [X_i; U_i]`: per step a 6 x 6 cost block (the quadratic features of
 //! Eq. 34 weighted by column `i` of `w`, the acceleration penalty around the reference
-//! profile's acceleration ([`Problem::reference_acceleration`]) and the tracking term), the affine dynamics, the fixed `X_0`, the terminal rows, and inequality rows
+//! profile's acceleration ([`Problem::reference_acceleration`]) and the tracking
+//! term), the affine dynamics, the fixed `X_0`, the terminal rows, and inequality rows
 //! that each touch one stage variable and at most one soft-bound slack `σ`.
 //!
 //! This is the one assembly: the Riccati backend reads it as it is, and the clarabel
