@@ -20,12 +20,16 @@
 //! settles without overshoot. When closing so fast that the comfortable
 //! deceleration `b` cannot match speeds before the standstill gap, the ego brakes
 //! with the kinematic deceleration `(v − v_l)² / (2 (g − s_0))`, up to the
-//! emergency limit (an automatic emergency brake).
+//! emergency limit (an automatic emergency brake). Under the safety layer the ACC
+//! also keeps the RSS safe distance ([`AccConfig::acceleration_keeping`]): closing
+//! within it (plus [`SAFE_DISTANCE_LEAD_S`] of closing speed), it brakes at RSS's
+//! `b_min`.
 
 use palc_traffic::{Driver, Scene};
 use serde::{Deserialize, Serialize};
 
 use crate::HarnessError;
+use crate::safety::SafetyConfig;
 
 /// Parameters of the ego's ACC; defaults in `configs/learn.toml` (`[planning.acc]`).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -172,6 +176,42 @@ impl AccConfig {
     }
 }
 
+/// Seconds of closing speed added to the safe distance at which the ACC starts
+/// RSS's proper response: a leader that brakes makes the safe distance grow by
+/// `v_l b_l / b_max` per second while the gap shrinks at the closing speed, so the
+/// response starts before the distance is reached rather than at it.
+pub const SAFE_DISTANCE_LEAD_S: f64 = 1.0;
+
+impl AccConfig {
+    /// [`acceleration`](Self::acceleration), and RSS's proper response towards the
+    /// leader: once the gap falls to the safe distance of `safety` (plus
+    /// [`SAFE_DISTANCE_LEAD_S`] of closing speed), at least `safety.min_braking_mps2`
+    /// of braking, up to the emergency limit. With the ACC off, 0.
+    pub fn acceleration_keeping(
+        &self,
+        v: f64,
+        set_speed: f64,
+        leader: Option<(f64, f64)>,
+        safety: &SafetyConfig,
+    ) -> f64 {
+        let a = self.acceleration(v, set_speed, leader);
+        let Some((gap, leader_v)) = leader.filter(|_| self.enabled) else {
+            return a;
+        };
+        let closing = (v - leader_v).max(0.0);
+        let keep = safety.safe_distance(v, leader_v) + SAFE_DISTANCE_LEAD_S * closing;
+        if closing > 0.0 && gap < keep {
+            a.min(
+                -safety
+                    .min_braking_mps2
+                    .min(self.emergency_deceleration_mps2),
+            )
+        } else {
+            a
+        }
+    }
+}
+
 /// The vehicle the ego's ACC follows: the nearest vehicle ahead (front bumper
 /// ahead of the ego's) in any lane the ego's body occupies, as (net gap, speed).
 pub fn acc_leader(scene: &Scene) -> Option<(f64, f64)> {
@@ -238,6 +278,27 @@ mod tests {
         assert!(acc.acceleration(20.0, 20.0, None).abs() < 1e-12);
         assert!((acc.acceleration(10.0, 30.0, None) - acc.max_acceleration_mps2).abs() < 1e-12);
         assert!(acc.acceleration(30.0, 20.0, Some((1000.0, 30.0))) < 0.0);
+    }
+
+    #[test]
+    fn keeping_the_safe_distance_brakes_at_the_rss_response_only_when_closing_inside_it() {
+        let (acc, safety) = (on(), SafetyConfig::default());
+        // Closing at 8 m/s from 40 m: the safe distance of 29 -> 21 m/s is about 45 m.
+        let plain = acc.acceleration(29.0, 29.0, Some((40.0, 21.0)));
+        let kept = acc.acceleration_keeping(29.0, 29.0, Some((40.0, 21.0)), &safety);
+        assert!(plain > -safety.min_braking_mps2, "{plain}");
+        assert!((kept + safety.min_braking_mps2).abs() < 1e-12, "{kept}");
+        // Far behind, or not closing, the plain law.
+        for leader in [Some((200.0, 21.0)), Some((10.0, 29.0)), None] {
+            let plain = acc.acceleration(29.0, 29.0, leader);
+            assert_eq!(acc.acceleration_keeping(29.0, 29.0, leader, &safety), plain);
+        }
+        // Off, nothing.
+        let off = AccConfig::default();
+        assert_eq!(
+            off.acceleration_keeping(29.0, 29.0, Some((40.0, 21.0)), &safety),
+            0.0
+        );
     }
 
     #[test]

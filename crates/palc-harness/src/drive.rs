@@ -133,9 +133,13 @@ pub fn execute(
                 ..plan.states[0]
             },
             (true, Some(previous)) => {
-                let acc = setup
-                    .acc
-                    .acceleration(previous.v, setup.set_speed, acc_leader(&scene));
+                let leader = acc_leader(&scene);
+                let acc = if setup.safety.enforce {
+                    let safety = &setup.safety;
+                    (setup.acc).acceleration_keeping(previous.v, setup.set_speed, leader, safety)
+                } else {
+                    setup.acc.acceleration(previous.v, setup.set_speed, leader)
+                };
                 let acceleration =
                     user.acceleration_after_takeover(expectation, i, previous.v, acc);
                 let moved = ballistic_step(previous.v, acceleration, dt);

@@ -92,6 +92,39 @@ fn the_acc_does_not_hit_a_leader_that_brakes_hard_to_a_stop() {
 }
 
 #[test]
+fn the_acc_keeping_the_safe_distance_never_falls_below_it_behind_a_braking_leader() {
+    let acc = AccConfig {
+        enabled: true,
+        ..AccConfig::default()
+    };
+    let safety = SafetyConfig::default();
+    let follow = |keeping: bool| {
+        drive(braking_leader(), 200, |scene| {
+            let e = scene.ego().unwrap().state;
+            let leader = acc_leader(scene);
+            let a = if keeping {
+                acc.acceleration_keeping(e.v, 25.0, leader, &safety)
+            } else {
+                acc.acceleration(e.v, 25.0, leader)
+            };
+            let moved = ballistic_step(e.v, a, 0.1);
+            EgoState {
+                s: e.s + moved.distance,
+                l: e.l,
+                v: moved.speed,
+                heading: 0.0,
+            }
+        })
+    };
+    let kept = follow(true);
+    assert!(kept.is_safe(), "{kept:?}");
+    // The plain ACC brakes only as hard as comfort allows until it must brake
+    // harder, and falls below the safe distance on the way.
+    let plain = follow(false);
+    assert!(!plain.collision && plain.rss_violations > 0, "{plain:?}");
+}
+
+#[test]
 fn an_ego_that_holds_its_speed_behind_the_same_leader_collides_and_is_flagged() {
     let scene = braking_leader();
     let metrics = drive(scene, 100, |scene| {
