@@ -185,7 +185,7 @@ pub const SAFE_DISTANCE_LEAD_S: f64 = 1.0;
 impl AccConfig {
     /// [`acceleration`](Self::acceleration), and RSS's proper response towards the
     /// leader: once the gap falls to the safe distance of `safety` (plus
-    /// [`SAFE_DISTANCE_LEAD_S`] of closing speed), at least `safety.min_braking_mps2`
+    /// `SAFE_DISTANCE_LEAD_S` = 1 s of closing speed), at least `safety.min_braking_mps2`
     /// of braking, up to the emergency limit. With the ACC off, 0.
     pub fn acceleration_keeping(
         &self,
