@@ -70,24 +70,28 @@ fn braking_leader() -> Scene {
     .unwrap()
 }
 
-#[test]
-fn the_acc_does_not_hit_a_leader_that_brakes_hard_to_a_stop() {
-    let acc = AccConfig {
-        enabled: true,
-        ..AccConfig::default()
-    };
-    let scene = braking_leader();
-    let metrics = drive(scene, 200, |scene| {
+/// Drives the ego behind the braking leader for 20 s at the acceleration that
+/// `law` gives for its speed and leader.
+fn follow_braking_leader(law: impl Fn(f64, Option<(f64, f64)>) -> f64) -> SafetyMetrics {
+    drive(braking_leader(), 200, |scene| {
         let e = scene.ego().unwrap().state;
-        let a = acc.acceleration(e.v, 25.0, acc_leader(scene));
-        let moved = ballistic_step(e.v, a, 0.1);
+        let moved = ballistic_step(e.v, law(e.v, acc_leader(scene)), 0.1);
         EgoState {
             s: e.s + moved.distance,
             l: e.l,
             v: moved.speed,
             heading: 0.0,
         }
-    });
+    })
+}
+
+#[test]
+fn the_acc_does_not_hit_a_leader_that_brakes_hard_to_a_stop() {
+    let acc = AccConfig {
+        enabled: true,
+        ..AccConfig::default()
+    };
+    let metrics = follow_braking_leader(|v, leader| acc.acceleration(v, 25.0, leader));
     assert!(!metrics.collision, "{metrics:?}");
 }
 
@@ -98,29 +102,12 @@ fn the_acc_keeping_the_safe_distance_never_falls_below_it_behind_a_braking_leade
         ..AccConfig::default()
     };
     let safety = SafetyConfig::default();
-    let follow = |keeping: bool| {
-        drive(braking_leader(), 200, |scene| {
-            let e = scene.ego().unwrap().state;
-            let leader = acc_leader(scene);
-            let a = if keeping {
-                acc.acceleration_keeping(e.v, 25.0, leader, &safety)
-            } else {
-                acc.acceleration(e.v, 25.0, leader)
-            };
-            let moved = ballistic_step(e.v, a, 0.1);
-            EgoState {
-                s: e.s + moved.distance,
-                l: e.l,
-                v: moved.speed,
-                heading: 0.0,
-            }
-        })
-    };
-    let kept = follow(true);
+    let kept =
+        follow_braking_leader(|v, leader| acc.acceleration_keeping(v, 25.0, leader, &safety));
     assert!(kept.is_safe(), "{kept:?}");
     // The plain ACC brakes only as hard as comfort allows until it must brake
     // harder, and falls below the safe distance on the way.
-    let plain = follow(false);
+    let plain = follow_braking_leader(|v, leader| acc.acceleration(v, 25.0, leader));
     assert!(!plain.collision && plain.rss_violations > 0, "{plain:?}");
 }
 
