@@ -183,6 +183,24 @@ impl AccConfig {
 pub const SAFE_DISTANCE_LEAD_S: f64 = 1.0;
 
 impl AccConfig {
+    /// The ego's acceleration under `safety`:
+    /// [`acceleration_keeping`](Self::acceleration_keeping) when the safety layer is on
+    /// (`safety.enforce`), else [`acceleration`](Self::acceleration) (the paper's
+    /// set-up is unchanged).
+    pub fn ego_acceleration(
+        &self,
+        v: f64,
+        set_speed: f64,
+        leader: Option<(f64, f64)>,
+        safety: &SafetyConfig,
+    ) -> f64 {
+        if safety.enforce {
+            self.acceleration_keeping(v, set_speed, leader, safety)
+        } else {
+            self.acceleration(v, set_speed, leader)
+        }
+    }
+
     /// [`acceleration`](Self::acceleration), and RSS's proper response towards the
     /// leader: once the gap falls to the safe distance of `safety` (plus
     /// `SAFE_DISTANCE_LEAD_S` = 1 s of closing speed), at least `safety.min_braking_mps2`
@@ -293,6 +311,14 @@ mod tests {
             let plain = acc.acceleration(29.0, 29.0, leader);
             assert_eq!(acc.acceleration_keeping(29.0, 29.0, leader, &safety), plain);
         }
+        // The ego keeps the distance only under the safety layer.
+        let enforced = SafetyConfig {
+            enforce: true,
+            ..safety
+        };
+        let leader = Some((40.0, 21.0));
+        assert_eq!(acc.ego_acceleration(29.0, 29.0, leader, &enforced), kept);
+        assert_eq!(acc.ego_acceleration(29.0, 29.0, leader, &safety), plain);
         // Off, nothing.
         let off = AccConfig::default();
         assert_eq!(

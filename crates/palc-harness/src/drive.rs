@@ -134,12 +134,12 @@ pub fn execute(
             },
             (true, Some(previous)) => {
                 let leader = acc_leader(&scene);
-                let acc = if setup.safety.enforce {
-                    let safety = &setup.safety;
-                    (setup.acc).acceleration_keeping(previous.v, setup.set_speed, leader, safety)
-                } else {
-                    setup.acc.acceleration(previous.v, setup.set_speed, leader)
-                };
+                let acc = (setup.acc).ego_acceleration(
+                    previous.v,
+                    setup.set_speed,
+                    leader,
+                    &setup.safety,
+                );
                 let acceleration =
                     user.acceleration_after_takeover(expectation, i, previous.v, acc);
                 let moved = ballistic_step(previous.v, acceleration, dt);

@@ -436,11 +436,7 @@ fn lane_keeping_step(
 ) -> Result<(), HarnessError> {
     let ego = scene.ego().map(|e| e.state).unwrap_or_default();
     let leader = acc_leader(scene);
-    let mut acceleration = if config.safety.enforce {
-        (config.acc).acceleration_keeping(ego.v, set_speed, leader, &config.safety)
-    } else {
-        config.acc.acceleration(ego.v, set_speed, leader)
-    };
+    let mut acceleration = (config.acc).ego_acceleration(ego.v, set_speed, leader, &config.safety);
     // Gap seeking: while the gap beside is neither acceptable to the standard ALC
     // nor safe, drop back below the target lane's speed so that the next gap
     // comes alongside.
