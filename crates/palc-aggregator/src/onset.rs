@@ -34,6 +34,21 @@ pub struct Onset {
     /// Net gap to the target lane's follower over the follower's speed (s), when
     /// that gap held the user back (as `lead_time_gap_s`). `None` otherwise.
     pub lag_time_gap_s: Option<f64>,
+    /// The largest net gap to the target lane's leader over the ego speed (s) that
+    /// the user refused in this scene after it had decided to change lanes: a step
+    /// before the start at which the decision feature had fallen to its threshold
+    /// (as learned from the onsets before and this one) and the follower's gap was
+    /// at least the one accepted at the start, so that only the leader's gap can
+    /// have held the user back. A lower bound on the lead gap the user needs (the
+    /// largest rejected gap of gap-acceptance models). `None` when no such step.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rejected_lead_time_gap_s: Option<f64>,
+    /// The time headway (s) at the last step before the target lane's follower
+    /// came alongside, when that follower held the user back (`lag_time_gap_s`
+    /// set): the user had not started there, so, if nothing else held it back,
+    /// its decision threshold is below this value. `None` otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub time_headway_ceiling_s: Option<f64>,
     /// Lessons this onset is the mean of.
     pub observations: u64,
 }
@@ -49,6 +64,8 @@ impl Onset {
             ("gap_m", Some(self.gap_m)),
             ("lead_time_gap_s", self.lead_time_gap_s),
             ("lag_time_gap_s", self.lag_time_gap_s),
+            ("rejected_lead_time_gap_s", self.rejected_lead_time_gap_s),
+            ("time_headway_ceiling_s", self.time_headway_ceiling_s),
         ];
         for (name, value) in values {
             if let Some(x) = value {
@@ -65,7 +82,8 @@ impl Onset {
 
     /// The running mean of this onset and `other`, observed in the same scene:
     /// each value weighted by its number of observations (an option present in
-    /// only one of the two is kept).
+    /// only one of the two is kept), except the refused lead gap, the larger of
+    /// the two (both are lower bounds).
     pub fn merged(&self, other: &Onset) -> Onset {
         let (a, b) = (self.observations as f64, other.observations as f64);
         let n = (a + b).max(1.0);
@@ -82,6 +100,17 @@ impl Onset {
             gap_m: mean(self.gap_m, other.gap_m),
             lead_time_gap_s: option(self.lead_time_gap_s, other.lead_time_gap_s),
             lag_time_gap_s: option(self.lag_time_gap_s, other.lag_time_gap_s),
+            rejected_lead_time_gap_s: match (
+                self.rejected_lead_time_gap_s,
+                other.rejected_lead_time_gap_s,
+            ) {
+                (Some(x), Some(y)) => Some(x.max(y)),
+                (x, y) => x.or(y),
+            },
+            time_headway_ceiling_s: option(
+                self.time_headway_ceiling_s,
+                other.time_headway_ceiling_s,
+            ),
             observations: self.observations + other.observations,
         }
     }
@@ -100,6 +129,8 @@ mod tests {
             gap_m: 20.0 * headway,
             lead_time_gap_s: None,
             lag_time_gap_s: lag,
+            rejected_lead_time_gap_s: None,
+            time_headway_ceiling_s: None,
             observations: n,
         }
     }

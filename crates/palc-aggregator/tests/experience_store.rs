@@ -58,6 +58,8 @@ fn sample_experience() -> Experience {
         gap_m: 24.6,
         lead_time_gap_s: None,
         lag_time_gap_s: Some(0.031),
+        rejected_lead_time_gap_s: Some(0.42),
+        time_headway_ceiling_s: None,
         observations: 2,
     }];
     experience.demonstration = Some((0..=20).map(|i| 3.5 * f64::from(i) / 20.0).collect());

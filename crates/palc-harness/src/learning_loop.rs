@@ -488,7 +488,12 @@ impl LearningLoop {
     /// Records the user's start `start_s` seen in a lesson in the experience:
     /// merged into this scene's onset, which becomes the anchor of the weights.
     fn observe_onset(&mut self, start_s: f64) {
-        let Some(observed) = onset_at(&self.setup, start_s) else {
+        let onsets = &self.experience.onsets;
+        let before = match onsets.last() {
+            Some(last) if last.scenario == self.setup.label => &onsets[..onsets.len() - 1],
+            _ => &onsets[..],
+        };
+        let Some(observed) = onset_at(&self.setup, start_s, before) else {
             return;
         };
         let onsets = &mut self.experience.onsets;

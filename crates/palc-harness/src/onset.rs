@@ -16,6 +16,13 @@
 //! gap-acceptance driver: the user decides when the decision feature falls to
 //! the learned threshold, then starts at the first step from there where the
 //! target-lane gaps are at least the learned ones ([`predicted_start_s`]).
+//!
+//! What one scene cannot show is bounded from what the user refused: a lead gap
+//! refused after the decision (a scene's onset learned with earlier scenes'
+//! decision threshold) bounds the lead gap the user needs from below, the largest
+//! rejected gap of gap-acceptance models; and when every onset was held back by
+//! a follower alongside, the headway just before that follower arrived bounds the
+//! decision from above (the user had not started there).
 
 use palc_aggregator::Onset;
 
@@ -182,16 +189,27 @@ fn held_back(setup: &Setup, step: usize, gap: fn(&Situation) -> Option<f64>) -> 
 
 /// The relative state of `setup` revealed by the user's start at `start_s`, as an
 /// [`Onset`] of one observation: each feature's threshold between its values at
-/// the start's step and the step before ([`revealed`]). `None` when the vehicle
-/// ahead is gone by then.
-pub(crate) fn onset_at(setup: &Setup, start_s: f64) -> Option<Onset> {
+/// the start's step and the step before ([`revealed`]), and what the user refused
+/// before it. `before` are the onsets of earlier scenes: with this one, they give
+/// the decision that tells which waits were for the leader's gap. `None` when the
+/// vehicle ahead is gone by then.
+pub(crate) fn onset_at(setup: &Setup, start_s: f64, before: &[Onset]) -> Option<Onset> {
     let step = start_step(setup, start_s)?;
     let binding = |gap: fn(&Situation) -> Option<f64>| {
-        held_back(setup, step, gap)
-            .then(|| revealed(setup, step, gap))
-            .flatten()
+        if !held_back(setup, step, gap) {
+            return None;
+        }
+        // A vehicle that leaves the side of the ego at the start's step reveals
+        // nothing beyond "not alongside": the threshold is 0, not the midpoint of a
+        // negative and a positive gap (which can lie above the next scene's first
+        // positive gap and predict the start a step late).
+        let previous = step.checked_sub(1).and_then(|i| gap(&setup.situations[i]));
+        match (previous, gap(&setup.situations[step])) {
+            (Some(before), Some(at)) if before <= 0.0 && at > 0.0 => Some(0.0),
+            _ => revealed(setup, step, gap),
+        }
     };
-    Some(Onset {
+    let mut onset = Onset {
         scenario: setup.label.clone(),
         time_s: start_s,
         time_headway_s: revealed(setup, step, |s| Some(s.time_headway_s))?,
@@ -199,8 +217,54 @@ pub(crate) fn onset_at(setup: &Setup, start_s: f64) -> Option<Onset> {
         gap_m: revealed(setup, step, |s| Some(s.preceding_gap_m))?,
         lead_time_gap_s: binding(lead_time_gap),
         lag_time_gap_s: binding(lag_time_gap),
+        rejected_lead_time_gap_s: None,
+        time_headway_ceiling_s: None,
         observations: 1,
-    })
+    };
+    if onset.lag_time_gap_s.is_some() {
+        onset.time_headway_ceiling_s =
+            step_before_alongside(setup, step).map(|i| setup.situations[i].time_headway_s);
+    }
+    let mut onsets = before.to_vec();
+    onsets.push(onset.clone());
+    onset.rejected_lead_time_gap_s = rejected_lead(setup, step, decision(&onsets));
+    Some(onset)
+}
+
+/// The last step before the target lane's follower came alongside the ego and
+/// held back the user who started at `step` (its time headway is
+/// [`Onset::time_headway_ceiling_s`]). `None` when the follower was not alongside
+/// at the step before the start, or was alongside from the plan's start.
+fn step_before_alongside(setup: &Setup, step: usize) -> Option<usize> {
+    let alongside = |i: usize| lag_time_gap(&setup.situations[i]).is_some_and(|g| g <= 0.0);
+    let first_alongside = (0..step).rev().take_while(|&i| alongside(i)).last()?;
+    let before = first_alongside.checked_sub(1)?;
+    Some(before)
+}
+
+/// The largest target-lane lead time gap the user refused before its start at
+/// `step` although it had decided (the decision feature at or below its
+/// threshold) and the follower's gap was at least the one it accepted at the
+/// start ([`Onset::rejected_lead_time_gap_s`]). Steps where the leader's gap was
+/// also at least the accepted one (or there was no leader) say nothing: there
+/// the decision learned so far does not explain the wait.
+fn rejected_lead(setup: &Setup, step: usize, (feature, threshold): (Decision, f64)) -> Option<f64> {
+    let start = &setup.situations[step];
+    let (lead_accepted, lag_accepted) = (lead_time_gap(start)?, lag_time_gap(start));
+    setup.situations[..step]
+        .iter()
+        .filter(|s| {
+            s.time_headway_s > 0.0 && feature.of_situation(s).is_some_and(|x| x <= threshold)
+        })
+        .filter(|s| match (lag_time_gap(s), lag_accepted) {
+            (None, _) => true,
+            (Some(g), Some(accepted)) => g >= accepted.max(0.0) && g > 0.0,
+            (Some(g), None) => g > 0.0,
+        })
+        .filter_map(lead_time_gap)
+        .filter(|&g| g < lead_accepted)
+        .reduce(f64::max)
+        .map(|g| g.max(0.0))
 }
 
 /// The feature of the vehicle ahead whose fall to a threshold decides the lane
@@ -234,7 +298,9 @@ impl Decision {
 ///
 /// Onsets a target-lane gap held back only bound the decision from below; the
 /// others give it. The threshold is the largest value seen (the earliest start the
-/// user has shown). The feature is the time headway (the paper's user model and
+/// user has shown). When every onset was held back, the time headway's threshold
+/// is raised to the lowest [`Onset::time_headway_ceiling_s`] above it: the earliest
+/// start the waits allow, assuming nothing but the follower held the user back. The feature is the time headway (the paper's user model and
 /// the usual measure of following) unless, over onsets from two or more scenes,
 /// it varies by more than [`CONSISTENT_SPREAD`] while the time to collision or the
 /// gap does not; then the most consistent of those.
@@ -246,7 +312,7 @@ fn decision(onsets: &[Onset]) -> (Decision, f64) {
     let informative: Vec<&Onset> = if free.is_empty() {
         onsets.iter().collect()
     } else {
-        free
+        free.clone()
     };
     let spread = |feature: Decision| -> Option<(f64, f64)> {
         let values: Vec<f64> = (informative.iter())
@@ -256,7 +322,17 @@ fn decision(onsets: &[Onset]) -> (Decision, f64) {
         let min = values.iter().copied().fold(f64::INFINITY, f64::min);
         (max > 0.0).then(|| ((max - min) / max, max))
     };
-    let headway = spread(Decision::TimeHeadway).unwrap_or((0.0, 0.0));
+    let mut headway = spread(Decision::TimeHeadway).unwrap_or((0.0, 0.0));
+    if free.is_empty() {
+        // Only lower bounds: take the earliest start they allow, the lowest
+        // headway at which a follower's arrival interrupted a wait.
+        let ceiling = (onsets.iter())
+            .filter_map(|o| o.time_headway_ceiling_s)
+            .reduce(f64::min);
+        if let Some(ceiling) = ceiling.filter(|&c| c > headway.1) {
+            headway.1 = ceiling;
+        }
+    }
     if informative.len() >= 2 && headway.0 > CONSISTENT_SPREAD {
         let best = [Decision::TimeToCollision, Decision::Gap]
             .into_iter()
@@ -283,14 +359,19 @@ fn acceptance(onsets: &[Onset], gap: fn(&Onset) -> Option<f64>) -> f64 {
 /// The user's start (s after the start of the plan) predicted in `setup` from the
 /// observed `onsets`: the first step at which the decision feature has fallen to
 /// its threshold, then the first step from there at which the target-lane gaps
-/// are at least the learned ones. `None` without onsets, or when the prediction
+/// are at least the learned ones (for the leader, also above every lead gap the
+/// user refused after deciding). `None` without onsets, or when the prediction
 /// does not start within the search window.
 pub(crate) fn predicted_start_s(setup: &Setup, onsets: &[Onset]) -> Option<f64> {
     if onsets.is_empty() {
         return None;
     }
     let (feature, threshold) = decision(onsets);
-    let lead = acceptance(onsets, |o| o.lead_time_gap_s);
+    // A lead gap the user refused after deciding is below the one it needs.
+    let refused = (onsets.iter())
+        .filter_map(|o| o.rejected_lead_time_gap_s)
+        .fold(0.0, f64::max);
+    let lead = acceptance(onsets, |o| o.lead_time_gap_s).max(refused);
     let lag = acceptance(onsets, |o| o.lag_time_gap_s);
     let situations = &setup.situations;
     let decides = |s: &Situation| {
@@ -373,6 +454,8 @@ mod tests {
             gap_m: 20.0 * headway,
             lead_time_gap_s: None,
             lag_time_gap_s: lag,
+            rejected_lead_time_gap_s: None,
+            time_headway_ceiling_s: None,
             observations: 1,
         }
     }
@@ -389,6 +472,23 @@ mod tests {
         // An onset held back by a gap does not set the decision.
         let held = [onset(1.2, 10.0, None), onset(0.3, 2.0, Some(0.1))];
         assert_eq!(decision(&held), (Decision::TimeHeadway, 1.2));
+    }
+
+    #[test]
+    fn without_a_free_onset_the_headway_rises_to_the_lowest_ceiling() {
+        let held = |headway: f64, ceiling: Option<f64>| Onset {
+            time_headway_ceiling_s: ceiling,
+            ..onset(headway, 10.0 * headway, Some(0.0))
+        };
+        // Two waits: the user had not started at 1.5 s nor at 1.3 s (neither the
+        // time to collision nor the gap is consistent across them).
+        let waits = [held(0.6, Some(1.5)), held(0.8, Some(1.3))];
+        assert_eq!(decision(&waits), (Decision::TimeHeadway, 1.3));
+        // A ceiling below a start the user has shown says nothing.
+        assert_eq!(decision(&[held(0.9, Some(0.7))]).1, 0.9);
+        // A free onset gives the threshold itself.
+        let with_free = [held(0.6, Some(1.5)), onset(1.2, 10.0, None)];
+        assert_eq!(decision(&with_free).1, 1.2);
     }
 
     #[test]

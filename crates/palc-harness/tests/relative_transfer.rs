@@ -140,3 +140,69 @@ fn under_the_safety_layer_the_predicted_start_waits_for_a_safe_gap() {
         );
     }
 }
+
+/// One user through `headways` of `speed_case` in order, each scene started from
+/// the experience of the one before; the experience after each scene.
+fn chain(
+    speed_case: &str,
+    headways: &[f64],
+    style: StylePreset,
+) -> Vec<palc_aggregator::Experience> {
+    let mut experiences: Vec<palc_aggregator::Experience> = Vec::new();
+    for &headway in headways {
+        let result = run(
+            &config(speed_case, headway, style),
+            experiences.last(),
+            &mut NoObserver,
+        )
+        .expect("the chained run completes");
+        experiences.push(result.experience);
+    }
+    experiences
+}
+
+#[test]
+fn a_lead_gap_refused_after_the_decision_bounds_the_users_from_below() {
+    // In arterial traffic at 45 m the user decides at its headway (known from the
+    // 50 m scene, where nothing held it back) and then waits seconds for the
+    // target lane: the lead gaps it refused while the follower was clear are
+    // below the one it needs.
+    let mut bounded = 0;
+    for speed_case in ["arterial-high", "arterial-slow"] {
+        for style in StylePreset::ALL {
+            let experiences = chain(speed_case, &[50.0, 45.0], style);
+            let needed = style.style().min_lead_gap_s;
+            for onset in &experiences[1].onsets {
+                if let Some(refused) = onset.rejected_lead_time_gap_s {
+                    assert!(
+                        (0.0..needed).contains(&refused),
+                        "{speed_case} {style:?}: refused {refused} s, the user needs {needed} s"
+                    );
+                    bounded += 1;
+                }
+            }
+        }
+    }
+    assert!(
+        bounded >= 2,
+        "only {bounded} scenes showed a refused lead gap"
+    );
+}
+
+#[test]
+fn experience_accumulated_over_headways_predicts_a_start_the_target_lane_holds_back() {
+    // After 50 m (free) and 45 m (the user waited for the target lane), the start
+    // at 40 m, where the user waits again, is predicted to the step.
+    for style in [StylePreset::Aggressive, StylePreset::Neutral] {
+        let experiences = chain("arterial-high", &[50.0, 45.0], style);
+        let target = config("arterial-high", 40.0, style);
+        let carried =
+            LearningLoop::new(&target, experiences.last()).expect("the target scenario prepares");
+        let anchor = (carried.experience().anchor_s).expect("the start is predicted");
+        let truth = true_start_s(&target);
+        assert!(
+            (anchor - truth).abs() <= target.planning.dt + 1e-9,
+            "{style:?}: predicted {anchor} s, the user starts at {truth} s"
+        );
+    }
+}
