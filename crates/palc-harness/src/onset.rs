@@ -2,13 +2,15 @@
 //! predicted in a new scene (docs/paper-mapping.md, "Experience in relative space").
 //!
 //! A takeover shows the user's own lateral profile from the takeover on. Its start
-//! is found by fitting a quintic (the paper's lane-change model, Section III.A)
-//! through two crossings of it: with `x(p)` the inverse of
+//! is found by fitting a lane-change model through two crossings of it, the
+//! paper's quintic (Section III.A) and a half-sine lateral speed, keeping the one
+//! closer to the whole profile driven ([`Shape`]). For the quintic: with `x(p)` the inverse of
 //! `p(x) = 10x³ − 15x⁴ + 6x⁵`, crossings of the fractions `p_a < p_b` of the lane
 //! change at `t_a` and `t_b` give the duration `D = (t_b − t_a) / (x(p_b) − x(p_a))`
 //! and the start `t_a − x(p_a) · D`. The crossings are interpolated between steps,
-//! so the start is found to a fraction of a step; another profile (cosine, a table)
-//! biases it by a few percent of its duration.
+//! so the start is found to a fraction of a step; a profile between or beyond
+//! the two models (a table, a late peak) biases it by a few percent of its
+//! duration.
 //!
 //! The relative state at that start ([`Onset`]: time headway, time to collision
 //! and gap to the vehicle ahead, and a target-lane gap when it held the user back)
@@ -47,23 +49,44 @@ const HELD_BACK_WINDOW_S: f64 = 1.0;
 /// scenes.
 const CONSISTENT_SPREAD: f64 = 0.1;
 
-/// The quintic lane-change profile `p(x)` on `[0, 1]`.
-fn quintic(x: f64) -> f64 {
-    x * x * x * (10.0 + x * (-15.0 + 6.0 * x))
+/// The lane-change models a user's start is fitted with: the paper's quintic
+/// (minimum jerk) and the half-sine lateral speed of many driver models. Both are
+/// fitted; the one closer to what the user drove is kept.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Shape {
+    /// `p(x) = 10x³ − 15x⁴ + 6x⁵`.
+    Quintic,
+    /// `p(x) = (1 − cos πx) / 2`.
+    HalfSine,
 }
 
-/// The inverse of [`quintic`] on `[0, 1]`, by bisection (it is increasing).
-fn quintic_inverse(p: f64) -> f64 {
-    let (mut low, mut high) = (0.0, 1.0);
-    for _ in 0..60 {
-        let mid = 0.5 * (low + high);
-        if quintic(mid) < p {
-            low = mid;
-        } else {
-            high = mid;
+impl Shape {
+    /// The shapes tried, the paper's first (it wins a tie).
+    const ALL: [Shape; 2] = [Shape::Quintic, Shape::HalfSine];
+
+    /// The fraction `p(x)` of the lane change done at the fraction `x` of its
+    /// duration, on `[0, 1]`.
+    fn fraction(self, x: f64) -> f64 {
+        match self {
+            Shape::Quintic => x * x * x * (10.0 + x * (-15.0 + 6.0 * x)),
+            Shape::HalfSine => 0.5 * (1.0 - (std::f64::consts::PI * x).cos()),
         }
     }
-    0.5 * (low + high)
+
+    /// The inverse of [`Shape::fraction`] on `[0, 1]`, by bisection (it is
+    /// increasing).
+    fn inverse(self, p: f64) -> f64 {
+        let (mut low, mut high) = (0.0, 1.0);
+        for _ in 0..60 {
+            let mid = 0.5 * (low + high);
+            if self.fraction(mid) < p {
+                low = mid;
+            } else {
+                high = mid;
+            }
+        }
+        0.5 * (low + high)
+    }
 }
 
 /// The time (s) at which the fraction `profile` first reaches `level` at or
@@ -75,9 +98,9 @@ fn crossing_s(profile: &[f64], from: usize, level: f64, dt: f64) -> Option<f64> 
     })
 }
 
-/// The user's own lane change seen in a lesson: the quintic fitted to the lateral
-/// positions `driven_l` the user drove from `takeover_step` on, towards `target_l`
-/// from 0.
+/// The user's own lane change seen in a lesson: the lane-change model ([`Shape`])
+/// fitted to the lateral positions `driven_l` the user drove from
+/// `takeover_step` on, towards `target_l` from 0.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct UserLaneChange {
     /// The user's start (s after the start of the plan).
@@ -86,12 +109,15 @@ pub(crate) struct UserLaneChange {
     pub duration_s: f64,
     /// The lateral offset it ends at (m).
     pub target_l: f64,
+    /// The model that fitted best.
+    pub shape: Shape,
 }
 
 impl UserLaneChange {
-    /// The fit described in the module documentation. `None` when the profile
-    /// after the takeover is too short to fit (the user was past 70 % of the lane
-    /// change at the takeover).
+    /// The fit described in the module documentation, with each [`Shape`]; the
+    /// one with the smallest squared error over the positions driven from the
+    /// takeover on is kept. `None` when the profile after the takeover is too
+    /// short to fit (the user was past 70 % of the lane change at the takeover).
     pub(crate) fn fit(
         driven_l: &[f64],
         takeover_step: usize,
@@ -110,23 +136,36 @@ impl UserLaneChange {
         }
         let t_a = crossing_s(&profile, takeover_step, lower, dt)?;
         let t_b = crossing_s(&profile, takeover_step, upper, dt)?;
-        let (x_a, x_b) = (quintic_inverse(lower), quintic_inverse(upper));
-        let duration = (t_b - t_a) / (x_b - x_a);
-        Some(UserLaneChange {
-            start_s: (t_a - x_a * duration).max(0.0),
-            duration_s: duration,
-            target_l,
-        })
+        let fitted = Shape::ALL.map(|shape| {
+            let (x_a, x_b) = (shape.inverse(lower), shape.inverse(upper));
+            let duration = (t_b - t_a) / (x_b - x_a);
+            let user = UserLaneChange {
+                start_s: (t_a - x_a * duration).max(0.0),
+                duration_s: duration,
+                target_l,
+                shape,
+            };
+            let error: f64 = (profile.iter().enumerate().skip(takeover_step))
+                .take_while(|&(i, _)| i as f64 * dt <= t_b)
+                .map(|(i, p)| (p - user.lateral(i as f64 * dt) / target_l).powi(2))
+                .sum();
+            (user, error)
+        });
+        let (best, _) = fitted
+            .into_iter()
+            .reduce(|best, next| if next.1 < best.1 { next } else { best })?;
+        Some(best)
     }
 
     /// The fitted lateral position (m) at time `t` (s): 0 before the start.
     pub(crate) fn lateral(&self, t: f64) -> f64 {
-        self.target_l * quintic(((t - self.start_s) / self.duration_s).clamp(0.0, 1.0))
+        let x = ((t - self.start_s) / self.duration_s).clamp(0.0, 1.0);
+        self.target_l * self.shape.fraction(x)
     }
 
     /// The user's lateral path in the lesson it was fitted to: what the user drove
     /// (`driven_l`) from `takeover_step` on, and before it, where the system drove,
-    /// this quintic.
+    /// the fitted model.
     pub(crate) fn path(&self, driven_l: &[f64], takeover_step: usize, dt: f64) -> Vec<f64> {
         (driven_l.iter().enumerate())
             .map(|(i, &l)| {
@@ -394,31 +433,57 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_quintic_inverse_inverts() {
-        for p in [0.0, 0.05, 0.1, 0.5, 0.9, 1.0] {
-            assert!((quintic(quintic_inverse(p)) - p).abs() < 1e-12, "{p}");
+    fn each_shapes_inverse_inverts() {
+        for shape in Shape::ALL {
+            for p in [0.0, 0.05, 0.1, 0.5, 0.9, 1.0] {
+                assert!((shape.fraction(shape.inverse(p)) - p).abs() < 1e-12, "{p}");
+            }
         }
     }
 
-    /// A quintic lane change starting at `start` (s), sampled at `dt`.
-    fn quintic_profile(start: f64, duration: f64, dt: f64, n: usize) -> Vec<f64> {
+    /// A lane change of `shape` starting at `start` (s), sampled at `dt`.
+    fn profile(shape: Shape, start: f64, duration: f64, dt: f64, n: usize) -> Vec<f64> {
         (0..n)
             .map(|i| {
                 let x = ((i as f64 * dt - start) / duration).clamp(0.0, 1.0);
-                3.5 * quintic(x)
+                3.5 * shape.fraction(x)
             })
             .collect()
     }
 
+    fn quintic_profile(start: f64, duration: f64, dt: f64, n: usize) -> Vec<f64> {
+        profile(Shape::Quintic, start, duration, dt, n)
+    }
+
     #[test]
-    fn the_start_of_a_quintic_is_found_between_steps() {
-        for (start, duration, takeover) in [(4.23, 2.1, 46), (4.23, 2.1, 30), (1.07, 1.7, 13)] {
-            let profile = quintic_profile(start, duration, 0.1, 120);
-            let found = UserLaneChange::fit(&profile, takeover, 0.1, 3.5)
-                .unwrap()
-                .start_s;
-            assert!((found - start).abs() < 0.02, "{found} vs {start}");
+    fn the_start_of_either_model_is_found_between_steps() {
+        for shape in Shape::ALL {
+            for (start, duration, takeover) in [(4.23, 2.1, 46), (4.23, 2.1, 30), (1.07, 1.7, 13)] {
+                let driven = profile(shape, start, duration, 0.1, 120);
+                let fit = UserLaneChange::fit(&driven, takeover, 0.1, 3.5).unwrap();
+                assert_eq!(fit.shape, shape);
+                assert!(
+                    (fit.start_s - start).abs() < 0.02,
+                    "{shape:?}: {} vs {start}",
+                    fit.start_s
+                );
+            }
         }
+    }
+
+    #[test]
+    fn the_quintic_alone_misplaces_a_half_sine_start() {
+        // Why both models are fitted: the quintic through the crossings of 10 %
+        // and 50 % puts a half-sine lane change of 2.1 s more than 0.1 s early.
+        let fraction: Vec<f64> = (profile(Shape::HalfSine, 4.23, 2.1, 0.1, 120).iter())
+            .map(|l| l / 3.5)
+            .collect();
+        let t_a = crossing_s(&fraction, 46, 0.1, 0.1).unwrap();
+        let t_b = crossing_s(&fraction, 46, 0.5, 0.1).unwrap();
+        let q = Shape::Quintic;
+        let duration = (t_b - t_a) / (q.inverse(0.5) - q.inverse(0.1));
+        let quintic_start = t_a - q.inverse(0.1) * duration;
+        assert!(4.23 - quintic_start > 0.1, "{quintic_start}");
     }
 
     #[test]

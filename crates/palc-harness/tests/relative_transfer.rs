@@ -206,3 +206,28 @@ fn experience_accumulated_over_headways_predicts_a_start_the_target_lane_holds_b
         );
     }
 }
+
+#[test]
+fn a_half_sine_user_is_carried_without_a_takeover() {
+    // The quintic alone puts a half-sine lane change's start 8 % of its duration
+    // early, a time that scenes with other closing speeds turn into different
+    // relative states: carried from arterial-high to arterial-slow (40 m), each
+    // style then needed a takeover. The half-sine model finds the start.
+    for style in StylePreset::ALL {
+        let text = format!(
+            "[user]\nstyle = \"{}\"\n[user.family.profile]\nshape = \"cosine\"\n",
+            style.name()
+        );
+        let user = UserConfig::from_toml_str(&text, 0.3).expect("the user parses");
+        let cosine = |speed_case: &str| config(speed_case, 40.0, style).with_user(user.clone());
+        let learned =
+            run(&cosine("arterial-high"), None, &mut NoObserver).expect("the source run completes");
+        let carried = run(
+            &cosine("arterial-slow"),
+            Some(&learned.experience),
+            &mut NoObserver,
+        )
+        .expect("the carried run completes");
+        assert_eq!(carried.summary.counted_takeovers(), 0, "{style:?}");
+    }
+}
