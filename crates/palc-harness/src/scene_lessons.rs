@@ -10,7 +10,10 @@
 //!
 //! `l̄(t) = (1/n) Σ_j l_j(S_j + (t − S̄) / D̄ · D_j)`,
 //!
-//! each path sampled at the same fraction of its own lane change. A user who
+//! each path sampled at the same fraction of its own lane change, over the
+//! lessons that started within one lane-change duration of the median start: a
+//! user with spread who takes another gap of the target lane made another
+//! decision, and the mean of two gaps is a lane change into neither. A user who
 //! repeats a lane change exactly (a deterministic user) gives the same path back,
 //! so averaging costs them nothing; for a user with spread the start, duration
 //! and shape each converge to their means (step `1/n`), whatever the profile's
@@ -26,7 +29,8 @@ pub(crate) struct SceneLessons {
 }
 
 impl SceneLessons {
-    /// Adds a lesson and returns the mean path of every lesson so far, at steps
+    /// Adds a lesson and returns the mean path of the lessons so far that started
+    /// with the median start (within one lane-change duration of it), at steps
     /// `0..path.len()` of `dt`. A path of another length than the first (another
     /// horizon) starts the mean again.
     pub(crate) fn add(&mut self, user: UserLaneChange, path: Vec<f64>, dt: f64) -> Vec<f64> {
@@ -38,18 +42,32 @@ impl SceneLessons {
             self.seen.clear();
         }
         self.seen.push((user, path));
-        let n = self.seen.len() as f64;
-        let start = self.seen.iter().map(|(u, _)| u.start_s).sum::<f64>() / n;
-        let duration = self.seen.iter().map(|(u, _)| u.duration_s).sum::<f64>() / n;
+        let mode = self.mode();
+        let n = mode.len() as f64;
+        let start = mode.iter().map(|(u, _)| u.start_s).sum::<f64>() / n;
+        let duration = mode.iter().map(|(u, _)| u.duration_s).sum::<f64>() / n;
         let steps = self.seen[0].1.len();
         (0..steps)
             .map(|i| {
                 let fraction = (i as f64 * dt - start) / duration;
-                let sum: f64 = (self.seen.iter())
+                let sum: f64 = (mode.iter())
                     .map(|(u, p)| sampled(p, (u.start_s + fraction * u.duration_s) / dt))
                     .sum();
                 sum / n
             })
+            .collect()
+    }
+
+    /// The lessons that started with the median start: within one lane-change
+    /// duration of it. A start further away is another decision (the user took
+    /// another gap of the target lane), and a mean across two gaps is a lane
+    /// change into neither.
+    fn mode(&self) -> Vec<&(UserLaneChange, Vec<f64>)> {
+        let mut starts: Vec<f64> = self.seen.iter().map(|(u, _)| u.start_s).collect();
+        starts.sort_by(f64::total_cmp);
+        let median = starts[(starts.len() - 1) / 2];
+        (self.seen.iter())
+            .filter(|(u, _)| (u.start_s - median).abs() <= u.duration_s)
             .collect()
     }
 }
@@ -80,6 +98,22 @@ mod tests {
         };
         let path = (0..120).map(|i| user.lateral(i as f64 * DT)).collect();
         (user, path)
+    }
+
+    #[test]
+    fn lessons_in_another_gap_stay_out_of_the_mean() {
+        // Two lane changes into the gap at 4 s, one into the gap at 13 s: the mean
+        // is the first gap's, not a lane change at 7 s.
+        let mut lessons = SceneLessons::default();
+        let mut mean = Vec::new();
+        for start in [4.0, 13.0, 4.2] {
+            let (user, path) = lane_change(start, 2.0);
+            mean = lessons.add(user, path, DT);
+        }
+        let (_, expected) = lane_change(4.1, 2.0);
+        for (a, b) in mean.iter().zip(&expected) {
+            assert!((a - b).abs() < 1e-9, "{a} != {b}");
+        }
     }
 
     #[test]
