@@ -488,22 +488,24 @@ impl LearningLoop {
     /// Records the user's start `start_s` seen in a lesson in the experience:
     /// merged into this scene's onset, which becomes the anchor of the weights.
     fn observe_onset(&mut self, start_s: f64) {
-        let onsets = &self.experience.onsets;
-        let before = match onsets.last() {
-            Some(last) if last.scenario == self.setup.label => &onsets[..onsets.len() - 1],
-            _ => &onsets[..],
+        let onsets = &mut self.experience.onsets;
+        // This scene's onset so far, taken out to be merged with the new one; the
+        // onsets of earlier scenes tell which waits were for the leader's gap.
+        let this_scene = if onsets
+            .last()
+            .is_some_and(|o| o.scenario == self.setup.label)
+        {
+            onsets.pop()
+        } else {
+            None
         };
-        let Some(observed) = onset_at(&self.setup, start_s, before) else {
+        let Some(observed) = onset_at(&self.setup, start_s, onsets) else {
+            onsets.extend(this_scene);
             return;
         };
-        let onsets = &mut self.experience.onsets;
-        let merged = match onsets.last() {
-            Some(last) if last.scenario == observed.scenario => {
-                let merged = last.merged(&observed);
-                onsets.pop();
-                merged
-            }
-            _ => observed,
+        let merged = match this_scene {
+            Some(last) => last.merged(&observed),
+            None => observed,
         };
         self.experience.anchor_s = Some(merged.time_s);
         onsets.push(merged);

@@ -4,13 +4,14 @@
 //! A takeover shows the user's own lateral profile from the takeover on. Its start
 //! is found by fitting a lane-change model through two crossings of it, the
 //! paper's quintic (Section III.A) and a half-sine lateral speed, keeping the one
-//! closer to the whole profile driven ([`Shape`]). For the quintic: with `x(p)` the inverse of
-//! `p(x) = 10x³ − 15x⁴ + 6x⁵`, crossings of the fractions `p_a < p_b` of the lane
-//! change at `t_a` and `t_b` give the duration `D = (t_b − t_a) / (x(p_b) − x(p_a))`
-//! and the start `t_a − x(p_a) · D`. The crossings are interpolated between steps,
-//! so the start is found to a fraction of a step; a profile between or beyond
-//! the two models (a table, a late peak) biases it by a few percent of its
-//! duration.
+//! closer to the profile up to the upper crossing, the part the start is
+//! extrapolated from ([`Shape`]). With `x(p)` the inverse of the model's `p(x)`
+//! (for the quintic `10x³ − 15x⁴ + 6x⁵`), crossings of the fractions `p_a < p_b`
+//! of the lane change at `t_a` and `t_b` give the duration
+//! `D = (t_b − t_a) / (x(p_b) − x(p_a))` and the start `t_a − x(p_a) · D`. The
+//! crossings are interpolated between steps, so the start is found to a fraction
+//! of a step; a profile between or beyond the two models (a table, a late peak)
+//! biases it by a few percent of its duration.
 //!
 //! The relative state at that start ([`Onset`]: time headway, time to collision
 //! and gap to the vehicle ahead, and a target-lane gap when it held the user back)
@@ -116,7 +117,7 @@ pub(crate) struct UserLaneChange {
 impl UserLaneChange {
     /// The fit described in the module documentation, with each [`Shape`]; the
     /// one with the smallest squared error over the positions driven from the
-    /// takeover on is kept. `None` when the profile after the takeover is too
+    /// takeover to the upper crossing is kept. `None` when the profile after the takeover is too
     /// short to fit (the user was past 70 % of the lane change at the takeover).
     pub(crate) fn fit(
         driven_l: &[f64],
@@ -277,8 +278,7 @@ pub(crate) fn onset_at(setup: &Setup, start_s: f64, before: &[Onset]) -> Option<
 fn step_before_alongside(setup: &Setup, step: usize) -> Option<usize> {
     let alongside = |i: usize| lag_time_gap(&setup.situations[i]).is_some_and(|g| g <= 0.0);
     let first_alongside = (0..step).rev().take_while(|&i| alongside(i)).last()?;
-    let before = first_alongside.checked_sub(1)?;
-    Some(before)
+    first_alongside.checked_sub(1)
 }
 
 /// The largest target-lane lead time gap the user refused before its start at
@@ -338,8 +338,9 @@ impl Decision {
 /// Onsets a target-lane gap held back only bound the decision from below; the
 /// others give it. The threshold is the largest value seen (the earliest start the
 /// user has shown). When every onset was held back, the time headway's threshold
-/// is raised to the lowest [`Onset::time_headway_ceiling_s`] above it: the earliest
-/// start the waits allow, assuming nothing but the follower held the user back. The feature is the time headway (the paper's user model and
+/// is raised to the lowest [`Onset::time_headway_ceiling_s`] above it: the
+/// earliest start the waits allow, assuming nothing but the follower held the
+/// user back. The feature is the time headway (the paper's user model and
 /// the usual measure of following) unless, over onsets from two or more scenes,
 /// it varies by more than [`CONSISTENT_SPREAD`] while the time to collision or the
 /// gap does not; then the most consistent of those.
