@@ -343,7 +343,10 @@ impl Decision {
 /// user back. The feature is the time headway (the paper's user model and
 /// the usual measure of following) unless, over onsets from two or more scenes,
 /// it varies by more than [`CONSISTENT_SPREAD`] while the time to collision or the
-/// gap does not; then the most consistent of those.
+/// gap does not, or a held-back onset started at a headway above the threshold
+/// (more than [`CONSISTENT_SPREAD`] above: a held-back start comes after the
+/// decision); then the most consistent of those that no held-back onset
+/// contradicts.
 fn decision(onsets: &[Onset]) -> (Decision, f64) {
     let free: Vec<&Onset> = onsets
         .iter()
@@ -373,11 +376,25 @@ fn decision(onsets: &[Onset]) -> (Decision, f64) {
             headway.1 = ceiling;
         }
     }
-    if informative.len() >= 2 && headway.0 > CONSISTENT_SPREAD {
+    // A held-back start comes after the decision: its value of the decision
+    // feature is at most the threshold. One above it contradicts the feature.
+    let contradicted = |feature: Decision, threshold: f64| {
+        !free.is_empty()
+            && (onsets.iter())
+                .filter(|o| o.lead_time_gap_s.is_some() || o.lag_time_gap_s.is_some())
+                .any(|o| {
+                    feature
+                        .of_onset(o)
+                        .is_some_and(|v| v > threshold * (1.0 + CONSISTENT_SPREAD))
+                })
+    };
+    let headway_fails = (informative.len() >= 2 && headway.0 > CONSISTENT_SPREAD)
+        || contradicted(Decision::TimeHeadway, headway.1);
+    if headway_fails {
         let best = [Decision::TimeToCollision, Decision::Gap]
             .into_iter()
             .filter_map(|d| spread(d).map(|(spread, max)| (d, spread, max)))
-            .filter(|&(_, spread, _)| spread <= CONSISTENT_SPREAD)
+            .filter(|&(d, spread, max)| spread <= CONSISTENT_SPREAD && !contradicted(d, max))
             .min_by(|a, b| a.1.total_cmp(&b.1));
         if let Some((feature, _, threshold)) = best {
             return (feature, threshold);
@@ -538,6 +555,27 @@ mod tests {
         // An onset held back by a gap does not set the decision.
         let held = [onset(1.2, 10.0, None), onset(0.3, 2.0, Some(0.1))];
         assert_eq!(decision(&held), (Decision::TimeHeadway, 1.2));
+    }
+
+    #[test]
+    fn a_held_back_start_above_the_threshold_rules_the_feature_out() {
+        // A time-to-collision user: free at a headway of 0.89 s, and held back by
+        // a follower in another scene until a headway of 1.41 s, earlier than a
+        // headway user at 0.89 s would have decided. Its time to collision there
+        // (6.3 s) is below the free onset's 8 s, as a decision before it requires.
+        let free = onset(0.89, 8.0, None);
+        let held = Onset {
+            gap_m: 10.0,
+            ..onset(1.41, 6.3, Some(0.0))
+        };
+        assert_eq!(decision(&[free.clone()]).0, Decision::TimeHeadway);
+        assert_eq!(decision(&[free, held]), (Decision::TimeToCollision, 8.0));
+        // A held-back start below the headway threshold contradicts nothing.
+        let below = onset(0.6, 6.3, Some(0.0));
+        assert_eq!(
+            decision(&[onset(0.89, 8.0, None), below]).0,
+            Decision::TimeHeadway
+        );
     }
 
     #[test]
