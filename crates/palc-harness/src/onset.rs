@@ -568,7 +568,10 @@ mod tests {
             gap_m: 10.0,
             ..onset(1.41, 6.3, Some(0.0))
         };
-        assert_eq!(decision(std::slice::from_ref(&free)).0, Decision::TimeHeadway);
+        assert_eq!(
+            decision(std::slice::from_ref(&free)).0,
+            Decision::TimeHeadway
+        );
         assert_eq!(decision(&[free, held]), (Decision::TimeToCollision, 8.0));
         // A held-back start below the headway threshold contradicts nothing.
         let below = onset(0.6, 6.3, Some(0.0));
