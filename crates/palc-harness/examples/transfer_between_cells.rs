@@ -24,7 +24,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let headways = testbed.adjacent_headways_m.clone();
     let mode = std::env::args().nth(1).unwrap_or_default();
     if let Some(axis) = mode.strip_prefix("chain-") {
-        return chain(&base, axis == "headway");
+        return chain(&base, &cases, &headways, axis == "headway");
     }
     let by_headway = mode == "headway";
     let representations = [Representation::TimeIndexed, Representation::RelativeOnset];
@@ -91,14 +91,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// with `by_headway` the headways in each speed case), seeds 1 and 2, each scene
 /// started from the experience of the one before; prints the mean takeovers after
 /// the first scene (the evaluation's accumulation experiment, deterministic users).
-fn chain(base: &LearnConfig, by_headway: bool) -> Result<(), Box<dyn std::error::Error>> {
-    let testbed = base
-        .traffic
-        .testbed
-        .as_ref()
-        .ok_or("learn.toml has a test bed")?;
-    let cases: Vec<String> = testbed.speed_cases.iter().map(|c| c.name.clone()).collect();
-    let headways = &testbed.adjacent_headways_m;
+fn chain(
+    base: &LearnConfig,
+    cases: &[String],
+    headways: &[f64],
+    by_headway: bool,
+) -> Result<(), Box<dyn std::error::Error>> {
     let rows: Vec<Vec<(String, f64)>> = if by_headway {
         (cases.iter())
             .map(|c| headways.iter().map(|&h| (c.clone(), h)).collect())
