@@ -26,7 +26,7 @@
 //! term in `δ`: it is the one feature that depends on where the plan starts (see
 //! [`Problem`]).
 
-use nalgebra::{Matrix4, Matrix4x2, Matrix6, Vector4, Vector6};
+use nalgebra::{Matrix4, Matrix6, Vector4, Vector6};
 
 use crate::riccati::StepDynamics;
 use crate::{LateralBoundsMode, PlannerConfig, Problem, feature};
@@ -237,15 +237,14 @@ impl StageQp {
         let steer_gain = dt / config.wheelbase;
         for i in 0..k {
             let v_ref = problem.reference_speed[i];
-            let mut a = Matrix4::identity();
-            a[(S, V)] = dt; // s' = v
-            a[(L, PHI)] = dt * v_ref; // l' = v_ref φ
-            let mut b = Matrix4x2::zeros();
-            b[(V, A - NX)] = dt; // v' = a
-            b[(PHI, DELTA - NX)] = steer_gain * v_ref; // φ' = v_ref/l_fr δ - v_ref R
             self.dynamics.push(Dynamics {
                 c: Vector4::new(0.0, 0.0, 0.0, -dt * v_ref * problem.curvature),
-                sparse: StepDynamics::new(&a, &b),
+                sparse: StepDynamics {
+                    ds: dt,                   // s' = v
+                    dl: dt * v_ref,           // l' = v_ref φ
+                    bv: dt,                   // v' = a
+                    bphi: steer_gain * v_ref, // φ' = v_ref/l_fr δ - v_ref R
+                },
             });
         }
         let t = &problem.terminal;

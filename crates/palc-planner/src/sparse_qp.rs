@@ -87,29 +87,15 @@ impl SparseQp {
         for (i, d) in qp.dynamics.iter().enumerate() {
             let r = NX + NX * i;
             let (x, u, next) = (state_index(i), control_index(i), state_index(i + 1));
-            match d.sparse {
-                StepDynamics::Bicycle { ds, dl, bv, bphi } => {
-                    for c in 0..NX {
-                        self.a(r + c, next + c, 1.0);
-                        self.a(r + c, x + c, -1.0);
-                    }
-                    self.a(r, x + 1, -ds); // s' = v
-                    self.a(r + 1, u, -bv); // v' = a
-                    self.a(r + 2, x + 3, -dl); // l' = v_ref φ
-                    self.a(r + 3, u + 1, -bphi); // φ' = v_ref/l_fr δ - v_ref R
-                }
-                StepDynamics::Dense { a, b } => {
-                    for row in 0..NX {
-                        self.a(r + row, next + row, 1.0);
-                        for c in 0..NX {
-                            self.a(r + row, x + c, -a[(row, c)]);
-                        }
-                        for c in 0..2 {
-                            self.a(r + row, u + c, -b[(row, c)]);
-                        }
-                    }
-                }
+            let StepDynamics { ds, dl, bv, bphi } = d.sparse;
+            for c in 0..NX {
+                self.a(r + c, next + c, 1.0);
+                self.a(r + c, x + c, -1.0);
             }
+            self.a(r, x + 1, -ds); // s' = v
+            self.a(r + 1, u, -bv); // v' = a
+            self.a(r + 2, x + 3, -dl); // l' = v_ref φ
+            self.a(r + 3, u + 1, -bphi); // φ' = v_ref/l_fr δ - v_ref R
             self.b.extend(d.c.iter());
         }
         let first_terminal = NX + NX * k;

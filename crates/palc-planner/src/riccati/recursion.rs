@@ -65,6 +65,10 @@ pub(crate) struct Step<'a> {
     pub y_initial: &'a mut Vector4<f64>,
     /// Multipliers of the terminal rows (entries `0..m`).
     pub y_terminal: &'a mut Vector4<f64>,
+    /// Whether to compute the multipliers of the dynamics and initial rows; without
+    /// them (the predictor, which needs only the primal step) the forward pass does
+    /// about half its work, and `y_dynamics`, `y_initial` keep stale values.
+    pub multipliers: bool,
 }
 
 /// Factorization and solve buffers for a horizon `K`.
@@ -209,18 +213,25 @@ impl Riccati {
     /// Solves the Newton system of the last [`factor`](Self::factor) for `rhs`.
     pub fn solve(&mut self, dynamics: &[Dynamics], rhs: &Rhs<'_>, mut out: Step<'_>) {
         let k = self.k;
-        self.p_vec[k] = rhs.linear[k].fixed_rows::<4>(0).into_owned();
+        let mut p_next = rhs.linear[k].fixed_rows::<4>(0).into_owned();
+        self.p_vec[k] = p_next;
         let mut w = -rhs.terminal;
+        // Slices of length `K`, bound once: no bounds checks in the loop (`p`, `gamma`
+        // start at step 1, the cost-to-go after the step).
+        let (p, gamma) = (&self.p[1..=k], &self.gamma[1..=k]);
+        let (r_inv, gain, bt_gamma) = (&self.r_inv[..k], &self.gain[..k], &self.bt_gamma[..k]);
+        let (dynamics, offsets, linear) = (&dynamics[..k], &rhs.offsets[..k], &rhs.linear[..k]);
+        let (p_vec, k_vec) = (&mut self.p_vec[..k], &mut self.k_vec[..k]);
         for i in (0..k).rev() {
             let d = &dynamics[i].sparse;
-            let f = &rhs.offsets[i];
-            let pf = self.p[i + 1] * f + self.p_vec[i + 1];
-            let r_bar = rhs.linear[i].fixed_rows::<2>(4) + d.b_tr_mul(&pf);
-            let kv = -(self.r_inv[i] * r_bar);
-            self.p_vec[i] =
-                rhs.linear[i].fixed_rows::<4>(0) + d.a_tr_mul(&pf) + self.gain[i].tr_mul(&r_bar);
-            w += self.gamma[i + 1].tr_mul(f) + self.bt_gamma[i].tr_mul(&kv);
-            self.k_vec[i] = kv;
+            let f = &offsets[i];
+            let pf = p[i] * f + p_next;
+            let r_bar = linear[i].fixed_rows::<2>(4) + d.b_tr_mul(&pf);
+            let kv = -(r_inv[i] * r_bar);
+            p_next = linear[i].fixed_rows::<4>(0) + d.a_tr_mul(&pf) + gain[i].tr_mul(&r_bar);
+            p_vec[i] = p_next;
+            w += gamma[i].tr_mul(f) + bt_gamma[i].tr_mul(&kv);
+            k_vec[i] = kv;
         }
         let mut nu = self.neg_w0_inv * (self.gamma[0].tr_mul(&rhs.initial) + w);
         for j in self.m..NX {
@@ -231,7 +242,11 @@ impl Riccati {
         // Newton step on it (forward pass only) restores the terminal rows, which the
         // interior point cannot otherwise correct.
         for _ in 0..=TERMINAL_REFINEMENTS {
-            self.forward(dynamics, rhs, &nu, &mut out);
+            if out.multipliers {
+                self.forward::<true>(dynamics, rhs, &nu, &mut out);
+            } else {
+                self.forward::<false>(dynamics, rhs, &nu, &mut out);
+            }
             let x_k = out.ux[self.k].fixed_rows::<4>(0).into_owned();
             let scale = 1.0 + x_k.amax() + rhs.terminal.amax();
             let mut residual = self.terminal * x_k - rhs.terminal;
@@ -245,18 +260,34 @@ impl Riccati {
         }
     }
 
-    /// The forward pass for a given `ν`: controls, states and multipliers.
-    fn forward(&self, dynamics: &[Dynamics], rhs: &Rhs<'_>, nu: &Vector4<f64>, out: &mut Step<'_>) {
+    /// The forward pass for a given `ν`: controls, states and, with `MULTIPLIERS`, the
+    /// multipliers.
+    fn forward<const MULTIPLIERS: bool>(
+        &self,
+        dynamics: &[Dynamics],
+        rhs: &Rhs<'_>,
+        nu: &Vector4<f64>,
+        out: &mut Step<'_>,
+    ) {
         let k = self.k;
         let mut x = rhs.initial;
-        *out.y_initial = -(self.p[0] * x + self.p_vec[0] + self.gamma[0] * nu);
+        if MULTIPLIERS {
+            *out.y_initial = -(self.p[0] * x + self.p_vec[0] + self.gamma[0] * nu);
+        }
+        // Slices of length `K`, bound once (`p`, `p_vec`, `gamma` from step 1).
+        let (p, p_vec, gamma) = (&self.p[1..=k], &self.p_vec[1..=k], &self.gamma[1..=k]);
+        let (gain, k_vec) = (&self.gain[..k], &self.k_vec[..k]);
+        let (r_inv, bt_gamma) = (&self.r_inv[..k], &self.bt_gamma[..k]);
+        let (dynamics, offsets) = (&dynamics[..k], &rhs.offsets[..k]);
+        let (ux, y_dynamics) = (&mut out.ux[..k], &mut out.y_dynamics[..k]);
         for i in 0..k {
             let d = &dynamics[i].sparse;
-            let u = self.gain[i] * x + self.k_vec[i] - self.r_inv[i] * (self.bt_gamma[i] * nu);
-            out.ux[i].fixed_rows_mut::<4>(0).copy_from(&x);
-            out.ux[i].fixed_rows_mut::<2>(4).copy_from(&u);
-            x = d.a_mul(&x) + d.b_mul(&u) + rhs.offsets[i];
-            out.y_dynamics[i] = -(self.p[i + 1] * x + self.p_vec[i + 1] + self.gamma[i + 1] * nu);
+            let u = gain[i] * x + k_vec[i] - r_inv[i] * (bt_gamma[i] * nu);
+            ux[i] = Vector6::new(x[0], x[1], x[2], x[3], u[0], u[1]);
+            x = d.a_mul(&x) + d.b_mul(&u) + offsets[i];
+            if MULTIPLIERS {
+                y_dynamics[i] = -(p[i] * x + p_vec[i] + gamma[i] * nu);
+            }
         }
         out.ux[k] = Vector6::new(x[0], x[1], x[2], x[3], 0.0, 0.0);
         *out.y_terminal = *nu;

@@ -174,7 +174,17 @@ impl Kkt {
     /// `d`: `(P + GᵀWG) Δx + Aᵀ y⁺ = -(Px + q + Gᵀξ)`, `A Δx = -r_eq`, then
     /// `Δs = -r_in - G Δx` and `Δλ = -(r_c + λ Δs) / s`; returns the largest step
     /// `α <= 1` that keeps `s` and `λ` non-negative.
-    pub fn solve(&mut self, qp: &StageQp, v: &Variables, r: &Residuals, d: &mut Direction) -> f64 {
+    ///
+    /// Without `multipliers` (the predictor), the equality multipliers of `d` are not
+    /// computed and keep stale values.
+    pub fn solve(
+        &mut self,
+        qp: &StageQp,
+        v: &Variables,
+        r: &Residuals,
+        d: &mut Direction,
+        multipliers: bool,
+    ) -> f64 {
         self.g.copy_from_slice(&r.grad);
         self.g_sigma.copy_from_slice(&qp.slack_cost);
         add_g_transpose(qp, &self.xi, &mut self.g, &mut self.g_sigma);
@@ -193,6 +203,7 @@ impl Kkt {
                 y_dynamics: &mut d.y_dynamics,
                 y_initial: &mut d.y_initial,
                 y_terminal: &mut d.y_terminal,
+                multipliers,
             },
         );
         recover_slacks(
@@ -262,6 +273,7 @@ impl Kkt {
                 y_dynamics: &mut c.y_dynamics,
                 y_initial: &mut dy0,
                 y_terminal: &mut dnu,
+                multipliers: true,
             },
         );
         recover_slacks(

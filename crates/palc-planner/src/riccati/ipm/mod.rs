@@ -191,7 +191,7 @@ impl Ipm {
         // rc, λ and 1/s are zero here, so the Δλ the step computes is unused noise-free 0.
         kkt.rc.fill(0.0);
         kkt.inv_s.fill(0.0);
-        kkt.solve(qp, v, residuals, d);
+        kkt.solve(qp, v, residuals, d, true);
         v.ux.copy_from_slice(&d.ux);
         v.sigma.copy_from_slice(&d.sigma);
         v.y_initial = d.y_initial;

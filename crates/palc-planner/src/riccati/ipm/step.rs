@@ -67,7 +67,8 @@ impl Ipm {
             sl / m_in
         };
         kkt.factor(qp)?;
-        let alpha = kkt.solve(qp, v, r, d);
+        // The predictor's step needs only Δx (for Δs, Δλ): no multipliers.
+        let alpha = kkt.solve(qp, v, r, d, false);
         let centering = {
             let (s, lambda, r_in) = (&v.s[..n], &v.lambda[..n], &r.inequality[..n]);
             let (inv_s, w) = (&kkt.inv_s[..n], &kkt.w[..n]);
@@ -88,7 +89,7 @@ impl Ipm {
             }
             centering
         };
-        let mut alpha = kkt.solve(qp, v, r, d);
+        let mut alpha = kkt.solve(qp, v, r, d, true);
         if refine {
             kkt.refine(qp, v, r, d);
             alpha = kkt.dual_step_to_boundary(v, d);
@@ -104,7 +105,7 @@ impl Ipm {
                 kkt.rc[j] = v.s[j] * v.lambda[j] - shift;
                 kkt.xi[j] = v.lambda[j] + kkt.w[j] * r.inequality[j] - kkt.rc[j] * kkt.inv_s[j];
             }
-            alpha = kkt.solve(qp, v, r, d);
+            alpha = kkt.solve(qp, v, r, d, true);
             if refine {
                 kkt.refine(qp, v, r, d);
                 alpha = kkt.dual_step_to_boundary(v, d);
