@@ -49,6 +49,12 @@ pub struct Onset {
     /// its decision threshold is below this value. `None` otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub time_headway_ceiling_s: Option<f64>,
+    /// The net gap to the target lane's leader over the ego speed (s) at the start
+    /// itself, whether or not it held the user back: the user accepted it, so the
+    /// lead gap it needs is at most this (the accepted gap of gap-acceptance
+    /// models). `None` without a leader at the start.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub accepted_lead_time_gap_s: Option<f64>,
     /// Lessons this onset is the mean of.
     pub observations: u64,
 }
@@ -66,6 +72,7 @@ impl Onset {
             ("lag_time_gap_s", self.lag_time_gap_s),
             ("rejected_lead_time_gap_s", self.rejected_lead_time_gap_s),
             ("time_headway_ceiling_s", self.time_headway_ceiling_s),
+            ("accepted_lead_time_gap_s", self.accepted_lead_time_gap_s),
         ];
         for (name, value) in values {
             if let Some(x) = value {
@@ -83,7 +90,8 @@ impl Onset {
     /// The running mean of this onset and `other`, observed in the same scene:
     /// each value weighted by its number of observations (an option present in
     /// only one of the two is kept), except the refused lead gap, the larger of
-    /// the two (both are lower bounds).
+    /// the two (both are lower bounds), and the accepted lead gap, the smaller (both
+    /// are upper bounds).
     pub fn merged(&self, other: &Onset) -> Onset {
         let (a, b) = (self.observations as f64, other.observations as f64);
         let n = (a + b).max(1.0);
@@ -111,6 +119,13 @@ impl Onset {
                 self.time_headway_ceiling_s,
                 other.time_headway_ceiling_s,
             ),
+            accepted_lead_time_gap_s: match (
+                self.accepted_lead_time_gap_s,
+                other.accepted_lead_time_gap_s,
+            ) {
+                (Some(x), Some(y)) => Some(x.min(y)),
+                (x, y) => x.or(y),
+            },
             observations: self.observations + other.observations,
         }
     }
@@ -131,8 +146,31 @@ mod tests {
             lag_time_gap_s: lag,
             rejected_lead_time_gap_s: None,
             time_headway_ceiling_s: None,
+            accepted_lead_time_gap_s: None,
             observations: n,
         }
+    }
+
+    #[test]
+    fn merging_keeps_the_smallest_accepted_lead_gap() {
+        let with = |gap: Option<f64>| Onset {
+            accepted_lead_time_gap_s: gap,
+            ..onset(1.0, 1.0, None, 1)
+        };
+        assert_eq!(
+            with(Some(0.9))
+                .merged(&with(Some(1.4)))
+                .accepted_lead_time_gap_s,
+            Some(0.9)
+        );
+        assert_eq!(
+            with(None).merged(&with(Some(1.4))).accepted_lead_time_gap_s,
+            Some(1.4)
+        );
+        assert_eq!(
+            with(None).merged(&with(None)).accepted_lead_time_gap_s,
+            None
+        );
     }
 
     #[test]

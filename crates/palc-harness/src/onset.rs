@@ -259,6 +259,7 @@ pub(crate) fn onset_at(setup: &Setup, start_s: f64, before: &[Onset]) -> Option<
         lag_time_gap_s: binding(lag_time_gap),
         rejected_lead_time_gap_s: None,
         time_headway_ceiling_s: None,
+        accepted_lead_time_gap_s: lead_time_gap(&setup.situations[step]).filter(|g| g.is_finite()),
         observations: 1,
     };
     if onset.lag_time_gap_s.is_some() {
@@ -428,7 +429,15 @@ pub(crate) fn predicted_start_s(setup: &Setup, onsets: &[Onset]) -> Option<f64> 
     let refused = (onsets.iter())
         .filter_map(|o| o.rejected_lead_time_gap_s)
         .fold(0.0, f64::max);
-    let lead = acceptance(onsets, |o| o.lead_time_gap_s).max(refused);
+    // What the user needs from the leader: at least what held it back or what it
+    // refused; of the rest, the standard ALC's requirement until the user has
+    // accepted a smaller gap (what it accepted bounds its requirement from above).
+    let accepted = (onsets.iter())
+        .filter_map(|o| o.accepted_lead_time_gap_s)
+        .reduce(f64::min)
+        .unwrap_or(f64::INFINITY);
+    let lead = (acceptance(onsets, |o| o.lead_time_gap_s).max(refused))
+        .max(setup.standard_min_lead_gap_s.min(accepted));
     let lag = acceptance(onsets, |o| o.lag_time_gap_s);
     let situations = &setup.situations;
     let decides = |s: &Situation| {
@@ -539,6 +548,7 @@ mod tests {
             lag_time_gap_s: lag,
             rejected_lead_time_gap_s: None,
             time_headway_ceiling_s: None,
+            accepted_lead_time_gap_s: None,
             observations: 1,
         }
     }

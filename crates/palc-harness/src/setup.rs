@@ -167,6 +167,11 @@ pub struct Setup {
     pub adjacent: Vec<[f64; 2]>,
     /// Start step of the standard ALC.
     pub standard_start_step: usize,
+    /// The smallest lead gap on the target lane the standard ALC accepts, as a time
+    /// gap at the ego's speed (s; `planning.standard_alc.min_lead_gap_s`): what the
+    /// relative-onset prediction assumes a user needs until the user has accepted
+    /// a smaller one.
+    pub standard_min_lead_gap_s: f64,
     /// Lateral position of the target lane's centre (m).
     pub target_l: f64,
 }
@@ -330,6 +335,7 @@ impl Setup {
             preceding,
             adjacent,
             standard_start_step,
+            standard_min_lead_gap_s: config.standard_alc.min_lead_gap_s,
             target_l: config.target_l,
         })
     }

@@ -148,14 +148,22 @@ fn chain(
     headways: &[f64],
     style: StylePreset,
 ) -> Vec<palc_aggregator::Experience> {
+    chain_with(speed_case, headways, style, |_| {})
+}
+
+/// [`chain`] with each scene's config changed by `configure`.
+fn chain_with(
+    speed_case: &str,
+    headways: &[f64],
+    style: StylePreset,
+    configure: impl Fn(&mut LearnConfig),
+) -> Vec<palc_aggregator::Experience> {
     let mut experiences: Vec<palc_aggregator::Experience> = Vec::new();
     for &headway in headways {
-        let result = run(
-            &config(speed_case, headway, style),
-            experiences.last(),
-            &mut NoObserver,
-        )
-        .expect("the chained run completes");
+        let mut config = config(speed_case, headway, style);
+        configure(&mut config);
+        let result =
+            run(&config, experiences.last(), &mut NoObserver).expect("the chained run completes");
         experiences.push(result.experience);
     }
     experiences
@@ -166,11 +174,16 @@ fn a_lead_gap_refused_after_the_decision_bounds_the_users_from_below() {
     // In arterial traffic at 45 m the user decides at its headway (known from the
     // 50 m scene, where nothing held it back) and then waits seconds for the
     // target lane: the lead gaps it refused while the follower was clear are
-    // below the one it needs.
+    // below the one it needs. With the standard ALC's own lead gap as the
+    // prediction's assumption, the carried start already waits there and the
+    // scene has no lesson; a standard ALC that accepts any lead gap leaves the
+    // prediction early, and the lesson shows what the user refused.
     let mut bounded = 0;
     for speed_case in ["arterial-high", "arterial-slow"] {
         for style in StylePreset::ALL {
-            let experiences = chain(speed_case, &[50.0, 45.0], style);
+            let experiences = chain_with(speed_case, &[50.0, 45.0], style, |config| {
+                config.planning.standard_alc.min_lead_gap_s = 1e-3;
+            });
             let needed = style.style().min_lead_gap_s;
             for onset in &experiences[1].onsets {
                 if let Some(refused) = onset.rejected_lead_time_gap_s {
@@ -229,5 +242,40 @@ fn a_half_sine_user_is_carried_without_a_takeover() {
         )
         .expect("the carried run completes");
         assert_eq!(carried.summary.counted_takeovers(), 0, "{style:?}");
+    }
+}
+
+#[test]
+fn a_short_lead_gap_in_denser_traffic_holds_the_carried_start_back() {
+    // At 50 m the users start as soon as they decide, into lead gaps of 1.7-1.8 s,
+    // which say nothing about the lead gap they need. At 30 m the leader is
+    // 0.3-0.4 s ahead when they decide, and they wait until the ego has passed it
+    // (their own 0.5-0.6 s). Assuming the standard ALC's 0.8 s until a user has
+    // accepted less puts the carried start at that wait; assuming any positive gap
+    // put it at the decision, 7 s early.
+    for style in [StylePreset::Aggressive, StylePreset::Neutral] {
+        let learned = run(
+            &config("collector-high", 50.0, style),
+            None,
+            &mut NoObserver,
+        )
+        .expect("the source run completes");
+        let onset = learned.experience.onsets.last().expect("an onset");
+        let accepted = onset
+            .accepted_lead_time_gap_s
+            .expect("a leader at the start");
+        assert!(accepted > 0.8, "{style:?}: accepted {accepted} s");
+        let target = config("collector-high", 30.0, style);
+        let carried = LearningLoop::new(&target, Some(&learned.experience))
+            .expect("the target scenario prepares");
+        let anchor = carried
+            .experience()
+            .anchor_s
+            .expect("the start is predicted");
+        let truth = true_start_s(&target);
+        assert!(
+            (anchor - truth).abs() <= target.planning.dt + 1e-9,
+            "{style:?}: predicted {anchor} s, the user starts at {truth} s"
+        );
     }
 }
