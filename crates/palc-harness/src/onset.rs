@@ -430,21 +430,27 @@ pub(crate) fn predicted_start_s(setup: &Setup, onsets: &[Onset]) -> Option<f64> 
         .filter_map(|o| o.rejected_lead_time_gap_s)
         .fold(0.0, f64::max);
     // What the user needs from the leader: at least what held it back or what it
-    // refused; of the rest, the standard ALC's requirement until the user has
+    // refused; of the rest, what the system itself requires until the user has
     // accepted a smaller gap (what it accepted bounds its requirement from above).
-    let accepted = (onsets.iter())
-        .filter_map(|o| o.accepted_lead_time_gap_s)
-        .reduce(f64::min)
-        .unwrap_or(f64::INFINITY);
-    let lead = (acceptance(onsets, |o| o.lead_time_gap_s).max(refused))
-        .max(setup.standard_min_lead_gap_s.min(accepted));
+    // The system's requirement is the standard ALC's lead gap, or, under the safety
+    // layer, the safe distance, which `accepts` below requires anyway.
+    let safety = &setup.safety;
+    let assumed = if safety.enforce {
+        0.0
+    } else {
+        let accepted = (onsets.iter())
+            .filter_map(|o| o.accepted_lead_time_gap_s)
+            .reduce(f64::min)
+            .unwrap_or(f64::INFINITY);
+        setup.standard_min_lead_gap_s.min(accepted)
+    };
+    let lead = (acceptance(onsets, |o| o.lead_time_gap_s).max(refused)).max(assumed);
     let lag = acceptance(onsets, |o| o.lag_time_gap_s);
     let situations = &setup.situations;
     let decides = |s: &Situation| {
         s.time_headway_s > 0.0 && feature.of_situation(s).is_some_and(|x| x <= threshold)
     };
     // Under the safety layer a start below the safe distance would be refused.
-    let safety = &setup.safety;
     let accepts = |s: &Situation| {
         lead_time_gap(s).is_none_or(|g| g > 0.0 && g >= lead)
             && lag_time_gap(s).is_none_or(|g| g > 0.0 && g >= lag)
