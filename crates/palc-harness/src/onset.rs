@@ -25,7 +25,10 @@
 //! decision threshold) bounds the lead gap the user needs from below, the largest
 //! rejected gap of gap-acceptance models; and when every onset was held back by
 //! a follower alongside, the headway just before that follower arrived bounds the
-//! decision from above (the user had not started there).
+//! decision from above (the user had not started there). A lead gap the user
+//! accepted bounds the one it needs from above; until it has accepted one smaller
+//! than the standard ALC's requirement, that requirement is assumed (the system's
+//! own, not fitted to any user).
 
 use palc_aggregator::Onset;
 
@@ -418,8 +421,9 @@ fn acceptance(onsets: &[Onset], gap: fn(&Onset) -> Option<f64>) -> f64 {
 /// observed `onsets`: the first step at which the decision feature has fallen to
 /// its threshold, then the first step from there at which the target-lane gaps
 /// are at least the learned ones (for the leader, also above every lead gap the
-/// user refused after deciding). `None` without onsets, or when the prediction
-/// does not start within the search window.
+/// user refused after deciding, and at least the standard ALC's lead gap or the
+/// smallest one the user accepted, whichever is smaller). `None` without onsets,
+/// or when the prediction does not start within the search window.
 pub(crate) fn predicted_start_s(setup: &Setup, onsets: &[Onset]) -> Option<f64> {
     if onsets.is_empty() {
         return None;

@@ -170,7 +170,8 @@ pub struct Setup {
     /// The smallest lead gap on the target lane the standard ALC accepts, as a time
     /// gap at the ego's speed (s; `planning.standard_alc.min_lead_gap_s`): what the
     /// relative-onset prediction assumes a user needs until the user has accepted
-    /// a smaller one.
+    /// a smaller one (not under the safety layer, where it requires the safe
+    /// distance instead).
     pub standard_min_lead_gap_s: f64,
     /// Lateral position of the target lane's centre (m).
     pub target_l: f64,
