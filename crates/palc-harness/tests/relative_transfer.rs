@@ -33,6 +33,26 @@ fn true_start_s(config: &LearnConfig) -> f64 {
     nominal.lane_change.start_s
 }
 
+/// The start a carried `experience` predicts in the scenario of `target` is the
+/// user's, to the step.
+fn assert_start_predicted_to_the_step(
+    target: &LearnConfig,
+    experience: &palc_aggregator::Experience,
+    style: StylePreset,
+) {
+    let carried =
+        LearningLoop::new(target, Some(experience)).expect("the target scenario prepares");
+    let anchor = carried
+        .experience()
+        .anchor_s
+        .expect("the start is predicted");
+    let truth = true_start_s(target);
+    assert!(
+        (anchor - truth).abs() <= target.planning.dt + 1e-9,
+        "{style:?}: predicted {anchor} s, the user starts at {truth} s"
+    );
+}
+
 #[test]
 fn the_start_seen_in_the_lessons_is_the_users() {
     for style in StylePreset::ALL {
@@ -57,17 +77,7 @@ fn a_carried_experience_starts_where_the_new_scene_puts_the_user() {
         let source = config("collector-high", 50.0, style);
         let learned = run(&source, None, &mut NoObserver).expect("the source run completes");
         let target = config("collector-slow", 50.0, style);
-        let carried = LearningLoop::new(&target, Some(&learned.experience))
-            .expect("the target scenario prepares");
-        let anchor = carried
-            .experience()
-            .anchor_s
-            .expect("the start is predicted");
-        let truth = true_start_s(&target);
-        assert!(
-            (anchor - truth).abs() <= target.planning.dt + 1e-9,
-            "{style:?}: predicted {anchor} s, the user starts at {truth} s"
-        );
+        assert_start_predicted_to_the_step(&target, &learned.experience, style);
     }
 }
 
@@ -209,14 +219,8 @@ fn experience_accumulated_over_headways_predicts_a_start_the_target_lane_holds_b
     for style in [StylePreset::Aggressive, StylePreset::Neutral] {
         let experiences = chain("arterial-high", &[50.0, 45.0], style);
         let target = config("arterial-high", 40.0, style);
-        let carried =
-            LearningLoop::new(&target, experiences.last()).expect("the target scenario prepares");
-        let anchor = (carried.experience().anchor_s).expect("the start is predicted");
-        let truth = true_start_s(&target);
-        assert!(
-            (anchor - truth).abs() <= target.planning.dt + 1e-9,
-            "{style:?}: predicted {anchor} s, the user starts at {truth} s"
-        );
+        let experience = experiences.last().expect("two scenes");
+        assert_start_predicted_to_the_step(&target, experience, style);
     }
 }
 
@@ -266,16 +270,6 @@ fn a_short_lead_gap_in_denser_traffic_holds_the_carried_start_back() {
             .expect("a leader at the start");
         assert!(accepted > 0.8, "{style:?}: accepted {accepted} s");
         let target = config("collector-high", 30.0, style);
-        let carried = LearningLoop::new(&target, Some(&learned.experience))
-            .expect("the target scenario prepares");
-        let anchor = carried
-            .experience()
-            .anchor_s
-            .expect("the start is predicted");
-        let truth = true_start_s(&target);
-        assert!(
-            (anchor - truth).abs() <= target.planning.dt + 1e-9,
-            "{style:?}: predicted {anchor} s, the user starts at {truth} s"
-        );
+        assert_start_predicted_to_the_step(&target, &learned.experience, style);
     }
 }
