@@ -44,9 +44,11 @@ pub struct Onset {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rejected_lead_time_gap_s: Option<f64>,
     /// The time headway (s) at the last step before the target lane's follower
-    /// came alongside, when that follower held the user back (`lag_time_gap_s`
-    /// set): the user had not started there, so, if nothing else held it back,
-    /// its decision threshold is below this value. `None` otherwise.
+    /// came alongside at which the target-lane gaps were open (as far as the
+    /// observer can tell), when that follower held the user back
+    /// (`lag_time_gap_s` set): the user had not started there, so, if nothing
+    /// else held it back, its decision threshold is below this value. `None`
+    /// otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub time_headway_ceiling_s: Option<f64>,
     /// The net gap to the target lane's leader over the ego speed (s) at the start

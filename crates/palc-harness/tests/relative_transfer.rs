@@ -273,3 +273,24 @@ fn a_short_lead_gap_in_denser_traffic_holds_the_carried_start_back() {
         assert_start_predicted_to_the_step(&target, &learned.experience, style);
     }
 }
+
+#[test]
+fn a_wait_for_the_leader_before_the_follower_arrived_does_not_lower_the_decision() {
+    // At arterial-high / 40 m the cautious user decides (1.76 s headway) while the
+    // target lane's leader is too close, then the follower comes alongside, and the
+    // user starts once the follower is behind, at a headway of 0.69 s. The step
+    // just before the follower arrived (headway 0.86 s) was not a moment it could
+    // have started: the leader's gap there was below what it is assumed to need.
+    // The decision is bounded by the last moment the gaps were open instead, and
+    // the carried start lands on the user's in collector-high / 40 m (before: 5.7 s
+    // late, at a decision threshold of 0.86 s).
+    let style = StylePreset::Cautious;
+    let source = config("arterial-high", 40.0, style);
+    let learned = run(&source, None, &mut NoObserver).expect("the source run completes");
+    let onset = learned.experience.onsets.last().expect("an onset");
+    assert!(onset.lag_time_gap_s.is_some(), "the follower held it back");
+    let ceiling = onset.time_headway_ceiling_s.expect("a ceiling");
+    assert!(ceiling > 1.0, "ceiling {ceiling} s");
+    let target = config("collector-high", 40.0, style);
+    assert_start_predicted_to_the_step(&target, &learned.experience, style);
+}
