@@ -47,7 +47,9 @@ pub struct Onset {
     /// came alongside at which the target-lane gaps were open (as far as the
     /// observer can tell), when that follower held the user back
     /// (`lag_time_gap_s` set): the user had not started there, so, if nothing
-    /// else held it back, its decision threshold is below this value. `None`
+    /// else held it back, its decision threshold is below this value. When the
+    /// gaps were never open before the follower came, the headway at the step
+    /// just before it came (the earliest start the wait allows). `None`
     /// otherwise.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub time_headway_ceiling_s: Option<f64>,

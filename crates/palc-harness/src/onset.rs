@@ -286,9 +286,16 @@ pub(crate) fn onset_at(setup: &Setup, start_s: f64, before: &[Onset]) -> Option<
 /// there, mistook a wait for the leader for an undecided user: over every pair of
 /// the transfer matrix (deterministic users) the carried start was right to the
 /// step in 158 of 246 pairs across speed cases instead of 145, and the
-/// time-to-collision users' 93 of 220 instead of 66 (docs/paper-mapping.md). `None`
-/// when the follower was not alongside at the step before the start, or no such
-/// step exists.
+/// time-to-collision users' 93 of 220 instead of 66 (docs/paper-mapping.md).
+///
+/// When the gaps were never open before the follower came, that step is the
+/// fallback: the earliest start the wait allows, the same choice as for the
+/// threshold itself ([`decision`]). Without a ceiling the decision kept only its
+/// lower bound, the latest start the wait allows; with the fallback the transfer
+/// matrix's pairs need 190 takeovers instead of 197 (deterministic users), and
+/// fewer or as many for every start rule (docs/paper-mapping.md). `None` when the
+/// follower was not alongside at the step before the start, or was alongside
+/// from the scene's first step.
 fn last_open_step_before_alongside(setup: &Setup, step: usize) -> Option<usize> {
     let alongside = |i: usize| lag_time_gap(&setup.situations[i]).is_some_and(|g| g <= 0.0);
     let first_alongside = (0..step).rev().take_while(|&i| alongside(i)).last()?;
@@ -300,9 +307,13 @@ fn last_open_step_before_alongside(setup: &Setup, step: usize) -> Option<usize> 
             && lag_time_gap(s).is_none_or(|g| g > 0.0)
             && (!setup.safety.enforce || target_gaps_safe(s, &setup.safety))
     };
+    // No such step: nothing in this scene shows that the leader's gap held the
+    // user back before the follower came, and the earliest start the wait allows
+    // is just before the follower arrived.
     (0..first_alongside)
         .rev()
         .find(|&i| could_start(&setup.situations[i]))
+        .or_else(|| first_alongside.checked_sub(1))
 }
 
 /// The lead gap (s) a user is assumed to need besides what it has shown, given

@@ -294,3 +294,27 @@ fn a_wait_for_the_leader_before_the_follower_arrived_does_not_lower_the_decision
     let target = config("collector-high", 40.0, style);
     assert_start_predicted_to_the_step(&target, &learned.experience, style);
 }
+
+#[test]
+fn a_follower_that_came_before_any_open_gap_still_bounds_the_decision() {
+    // At collector-high / 50 m the cautious user starts at a headway of 1.41 s,
+    // as soon as the follower that came alongside is behind it; before the
+    // follower came, the leader's gap was never as large as the one the user is
+    // assumed to need, so no step shows when the gaps were open. The decision is
+    // then bounded by the step just before the follower arrived (1.67 s), the
+    // earliest start the wait allows; with the lower bound alone (1.41 s) the
+    // carried start in collector-high / 45 m came 1.0 s after the user's.
+    let style = StylePreset::Cautious;
+    let source = config("collector-high", 50.0, style);
+    let learned = run(&source, None, &mut NoObserver).expect("the source run completes");
+    let onset = learned.experience.onsets.last().expect("an onset");
+    assert!(onset.lag_time_gap_s.is_some(), "the follower held it back");
+    let ceiling = onset.time_headway_ceiling_s.expect("a ceiling");
+    assert!(
+        ceiling > onset.time_headway_s + 0.1,
+        "ceiling {ceiling} s, start at {} s",
+        onset.time_headway_s
+    );
+    let target = config("collector-high", 45.0, style);
+    assert_start_predicted_to_the_step(&target, &learned.experience, style);
+}
