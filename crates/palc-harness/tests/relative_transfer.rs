@@ -318,3 +318,26 @@ fn a_follower_that_came_before_any_open_gap_still_bounds_the_decision() {
     let target = config("collector-high", 45.0, style);
     assert_start_predicted_to_the_step(&target, &learned.experience, style);
 }
+
+#[test]
+fn a_start_after_the_follower_has_left_is_a_decision_not_a_wait() {
+    // At collector-high / 30 m the cautious user starts at its own threshold
+    // (1.76 s), a few steps after the target lane's follower left the ego's side.
+    // Read as a wait for that follower (a vehicle alongside within 1 s before the
+    // start), the start only bounded the decision from below and taught a follower
+    // gap of 0.1 s, and the carried start in collector-high / 50 m came 0.7 s
+    // after the user's. The follower held the user back only if it was alongside
+    // at the step before the start.
+    let style = StylePreset::Cautious;
+    let source = config("collector-high", 30.0, style);
+    let learned = run(&source, None, &mut NoObserver).expect("the source run completes");
+    let onset = learned.experience.onsets.last().expect("an onset");
+    assert_eq!(onset.lag_time_gap_s, None, "a free start");
+    assert!(
+        (onset.time_headway_s - 1.76).abs() < 0.05,
+        "decided at {} s",
+        onset.time_headway_s
+    );
+    let target = config("collector-high", 50.0, style);
+    assert_start_predicted_to_the_step(&target, &learned.experience, style);
+}
