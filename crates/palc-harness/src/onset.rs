@@ -311,9 +311,9 @@ fn last_open_step_before_alongside(setup: &Setup, step: usize) -> Option<usize> 
             && lag_time_gap(s).is_none_or(|g| g > 0.0)
             && (!setup.safety.enforce || target_gaps_safe(s, &setup.safety))
     };
-    // No such step: nothing in this scene shows that the leader's gap held the
-    // user back before the follower came, and the earliest start the wait allows
-    // is just before the follower arrived.
+    // No such step: the scene cannot tell whether the leader's gap or a decision
+    // not yet taken kept the user from starting before the follower came; take
+    // the earliest start the wait allows, just before the follower arrived.
     (0..first_alongside)
         .rev()
         .find(|&i| could_start(&setup.situations[i]))
