@@ -33,6 +33,13 @@ fn true_start_s(config: &LearnConfig) -> f64 {
     nominal.lane_change.start_s
 }
 
+/// The experience a run from scratch in `source` ends with.
+fn learned_in(source: &LearnConfig) -> palc_aggregator::Experience {
+    run(source, None, &mut NoObserver)
+        .expect("the source run completes")
+        .experience
+}
+
 /// The start a carried `experience` predicts in the scenario of `target` is the
 /// user's, to the step.
 fn assert_start_predicted_to_the_step(
@@ -74,10 +81,9 @@ fn a_carried_experience_starts_where_the_new_scene_puts_the_user() {
     // Same headway user, closing speed doubled: the time from the plan's start to
     // the user's start halves, which a time-indexed experience cannot know.
     for style in StylePreset::ALL {
-        let source = config("collector-high", 50.0, style);
-        let learned = run(&source, None, &mut NoObserver).expect("the source run completes");
+        let experience = learned_in(&config("collector-high", 50.0, style));
         let target = config("collector-slow", 50.0, style);
-        assert_start_predicted_to_the_step(&target, &learned.experience, style);
+        assert_start_predicted_to_the_step(&target, &experience, style);
     }
 }
 
@@ -85,12 +91,11 @@ fn a_carried_experience_starts_where_the_new_scene_puts_the_user() {
 fn relative_onset_transfers_better_than_time_indexing() {
     let (mut relative_sum, mut time_indexed_sum) = (0, 0);
     for style in StylePreset::ALL {
-        let source = config("collector-slow", 40.0, style);
-        let learned = run(&source, None, &mut NoObserver).expect("the source run completes");
+        let experience = learned_in(&config("collector-slow", 40.0, style));
         let target = config("collector-high", 40.0, style);
         let takeovers = |representation| {
             let config = with_representation(&target, representation);
-            run(&config, Some(&learned.experience), &mut NoObserver)
+            run(&config, Some(&experience), &mut NoObserver)
                 .expect("the transfer run completes")
                 .summary
                 .counted_takeovers()
@@ -285,14 +290,13 @@ fn a_wait_for_the_leader_before_the_follower_arrived_does_not_lower_the_decision
     // the carried start lands on the user's in collector-high / 40 m (before: 5.7 s
     // late, at a decision threshold of 0.86 s).
     let style = StylePreset::Cautious;
-    let source = config("arterial-high", 40.0, style);
-    let learned = run(&source, None, &mut NoObserver).expect("the source run completes");
-    let onset = learned.experience.onsets.last().expect("an onset");
+    let experience = learned_in(&config("arterial-high", 40.0, style));
+    let onset = experience.onsets.last().expect("an onset");
     assert!(onset.lag_time_gap_s.is_some(), "the follower held it back");
     let ceiling = onset.time_headway_ceiling_s.expect("a ceiling");
     assert!(ceiling > 1.0, "ceiling {ceiling} s");
     let target = config("collector-high", 40.0, style);
-    assert_start_predicted_to_the_step(&target, &learned.experience, style);
+    assert_start_predicted_to_the_step(&target, &experience, style);
 }
 
 #[test]
@@ -305,9 +309,8 @@ fn a_follower_that_came_before_any_open_gap_still_bounds_the_decision() {
     // earliest start the wait allows; with the lower bound alone (1.41 s) the
     // carried start in collector-high / 45 m came 1.0 s after the user's.
     let style = StylePreset::Cautious;
-    let source = config("collector-high", 50.0, style);
-    let learned = run(&source, None, &mut NoObserver).expect("the source run completes");
-    let onset = learned.experience.onsets.last().expect("an onset");
+    let experience = learned_in(&config("collector-high", 50.0, style));
+    let onset = experience.onsets.last().expect("an onset");
     assert!(onset.lag_time_gap_s.is_some(), "the follower held it back");
     let ceiling = onset.time_headway_ceiling_s.expect("a ceiling");
     assert!(
@@ -316,7 +319,7 @@ fn a_follower_that_came_before_any_open_gap_still_bounds_the_decision() {
         onset.time_headway_s
     );
     let target = config("collector-high", 45.0, style);
-    assert_start_predicted_to_the_step(&target, &learned.experience, style);
+    assert_start_predicted_to_the_step(&target, &experience, style);
 }
 
 #[test]
@@ -329,9 +332,8 @@ fn a_start_after_the_follower_has_left_is_a_decision_not_a_wait() {
     // after the user's. The follower held the user back only if it was alongside
     // at the step before the start.
     let style = StylePreset::Cautious;
-    let source = config("collector-high", 30.0, style);
-    let learned = run(&source, None, &mut NoObserver).expect("the source run completes");
-    let onset = learned.experience.onsets.last().expect("an onset");
+    let experience = learned_in(&config("collector-high", 30.0, style));
+    let onset = experience.onsets.last().expect("an onset");
     assert_eq!(onset.lag_time_gap_s, None, "a free start");
     assert!(
         (onset.time_headway_s - 1.76).abs() < 0.05,
@@ -339,5 +341,5 @@ fn a_start_after_the_follower_has_left_is_a_decision_not_a_wait() {
         onset.time_headway_s
     );
     let target = config("collector-high", 50.0, style);
-    assert_start_predicted_to_the_step(&target, &learned.experience, style);
+    assert_start_predicted_to_the_step(&target, &experience, style);
 }
