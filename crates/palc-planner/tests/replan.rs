@@ -130,3 +130,41 @@ fn replan_from_another_plan_is_a_cold_plan() {
     let replanned = planner.replan(&next, &previous).unwrap();
     assert_eq!(replanned.states, cold.states);
 }
+
+/// A planner carries nothing from one plan to the next but the last plan a re-plan
+/// starts from: its buffers are kept between plans and not zeroed, so every entry
+/// must be written before it is read. After cold plans and re-plans of another
+/// problem, with hard and soft bounds, each plan and re-plan is bit for bit a new
+/// planner's.
+#[test]
+fn a_used_planner_plans_as_a_new_one() {
+    for mode in [
+        LateralBoundsMode::Hard,
+        LateralBoundsMode::Soft { weight: 100.0 },
+    ] {
+        let config = PlannerConfig {
+            horizon: 60,
+            dt: 0.1,
+            lateral_bounds_mode: mode,
+            ..PlannerConfig::default()
+        };
+        let mut used = Planner::new(config.clone()).unwrap();
+        let other = lane_change(&config, 26.0);
+        let plan = used.plan(&other).unwrap();
+        used.replan(&shifted(&other, &plan), &plan).unwrap();
+
+        let mut new = Planner::new(config.clone()).unwrap();
+        let first = lane_change(&config, 18.0);
+        let (a, b) = (used.plan(&first).unwrap(), new.plan(&first).unwrap());
+        assert_eq!(a.states, b.states, "{mode:?}");
+        assert_eq!(a.lateral_violation, b.lateral_violation, "{mode:?}");
+        let next = shifted(&first, &a);
+        let (a, b) = (
+            used.replan(&next, &a).unwrap(),
+            new.replan(&next, &b).unwrap(),
+        );
+        assert_eq!(a.states, b.states, "{mode:?}");
+        assert_eq!(a.lateral_violation, b.lateral_violation, "{mode:?}");
+        assert_eq!(a.stats.iterations, b.stats.iterations, "{mode:?}");
+    }
+}

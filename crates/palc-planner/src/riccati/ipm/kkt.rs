@@ -22,7 +22,7 @@ use super::super::recursion::{FactorError, Rhs, Riccati, Step};
 use super::head;
 use super::residuals::Residuals;
 use super::step::dual_step;
-use super::variables::{Direction, Variables, resize_fill};
+use super::variables::{Direction, Variables, resize_keep};
 use crate::qp::StageQp;
 
 /// The Newton system's data, its factorization and its solve buffers.
@@ -107,21 +107,21 @@ impl Kkt {
     pub fn reset(&mut self, qp: &StageQp) {
         let (k, n_slack, m_in) = (qp.k, qp.slack_cost.len(), qp.inequalities.len());
         for v in [&mut self.newton_diag, &mut self.g, &mut self.e] {
-            resize_fill(v, k + 1, Vector6::zeros());
+            resize_keep(v, k + 1, Vector6::zeros());
         }
-        resize_fill(&mut self.zero_offsets, k, Vector4::zeros());
+        resize_keep(&mut self.zero_offsets, k, Vector4::zeros());
         for v in [
             &mut self.inv_h_ss,
             &mut self.h_sv,
             &mut self.g_sigma,
             &mut self.e_sigma,
         ] {
-            resize_fill(v, n_slack, 0.0);
+            resize_keep(v, n_slack, 0.0);
         }
         for v in [&mut self.w, &mut self.inv_s, &mut self.xi, &mut self.rc] {
-            resize_fill(v, m_in, 0.0);
+            resize_keep(v, m_in, 0.0);
         }
-        self.correction.reset(k, n_slack, m_in);
+        self.correction.resize(k, n_slack, m_in);
         self.riccati.resize(k);
     }
 

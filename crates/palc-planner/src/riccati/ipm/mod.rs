@@ -82,14 +82,13 @@ pub(crate) struct Ipm {
 }
 
 impl Ipm {
-    /// Sizes every buffer for `qp` (the only allocation of a solve) and sets the
-    /// iterate to zero.
+    /// Sizes every buffer for `qp` (the only allocation of a solve).
     pub fn resize(&mut self, qp: &StageQp) {
         let (k, n_slack, m_in) = (qp.k, qp.slack_cost.len(), qp.inequalities.len());
-        self.v.reset(k, n_slack, m_in);
-        self.d.reset(k, n_slack, m_in);
-        self.best.reset(k, n_slack, m_in);
-        self.certificate.reset(k, n_slack, m_in);
+        self.v.resize(k, n_slack, m_in);
+        self.d.resize(k, n_slack, m_in);
+        self.best.resize(k, n_slack, m_in);
+        self.certificate.resize(k, n_slack, m_in);
         self.residuals.reset(qp);
         self.kkt.reset(qp);
         self.iterations = 0;
@@ -182,6 +181,8 @@ impl Ipm {
             kkt,
             ..
         } = self;
+        // The Newton system at x = 0.
+        v.zero();
         residuals.compute(qp, v);
         kkt.w.fill(1.0);
         kkt.factor(qp)?;

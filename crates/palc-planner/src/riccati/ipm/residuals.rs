@@ -18,7 +18,7 @@ use nalgebra::{SVector, Vector4, Vector6};
 
 use super::head;
 use super::info::Measures;
-use super::variables::{Variables, resize_fill};
+use super::variables::{Variables, resize_keep};
 use crate::qp::{NX, StageQp};
 
 /// The residuals of the current iterate, in stage form.
@@ -49,11 +49,11 @@ impl Residuals {
     /// Sizes the buffers for `qp` and computes its data norms.
     pub fn reset(&mut self, qp: &StageQp) {
         let (k, n_slack, m_in) = (qp.k, qp.slack_cost.len(), qp.inequalities.len());
-        resize_fill(&mut self.grad, k + 1, Vector6::zeros());
-        resize_fill(&mut self.dual, k + 1, Vector6::zeros());
-        resize_fill(&mut self.dual_sigma, n_slack, 0.0);
-        resize_fill(&mut self.inequality, m_in, 0.0);
-        resize_fill(&mut self.offsets, k, Vector4::zeros());
+        resize_keep(&mut self.grad, k + 1, Vector6::zeros());
+        resize_keep(&mut self.dual, k + 1, Vector6::zeros());
+        resize_keep(&mut self.dual_sigma, n_slack, 0.0);
+        resize_keep(&mut self.inequality, m_in, 0.0);
+        resize_keep(&mut self.offsets, k, Vector4::zeros());
         self.initial = Vector4::zeros();
         self.terminal = Vector4::zeros();
         let m = qp.terminal_rows;

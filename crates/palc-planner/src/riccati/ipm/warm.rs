@@ -60,7 +60,8 @@ impl Ipm {
             return false;
         }
         let (old, w) = (&self.v, &mut self.shifted);
-        w.reset(k, n_slack, m_in);
+        // Every entry is written below.
+        w.resize(k, n_slack, m_in);
 
         // Stage variables: stage i from old stage i + 1, positions relative to old X_1.
         let origin = old.ux[1][0];
