@@ -46,6 +46,17 @@ pub struct AggregatorOptions {
     /// draw. A first lesson is learned as it is, and a new scene starts a new mean.
     /// Default `true`; the paper's method learns from the last lesson alone.
     pub average_lessons: bool,
+    /// Follow the user's speed (applied by the loop, `palc_harness`): after a
+    /// lesson in which the user, having taken over, drove at a speed of its own
+    /// (another acceleration than the ego's ACC would have commanded), the plan's
+    /// reference and terminal speeds from the takeover on are the speeds the user
+    /// drove, so that the next plan moves along the road as the user did (a user
+    /// who slows to the target lane's speed no longer sees the plan close on the
+    /// target lane's leader). The learned weights change the lateral rows only.
+    /// Within a scene: a new scene starts from its own speeds; and not under the
+    /// safety layer, whose ACC keeps the safe distance. Default `true`; the
+    /// paper's method plans at the scenario's speeds.
+    pub follow_user_speed: bool,
 }
 
 /// How learned weights carry into another scene (docs/paper-mapping.md,
@@ -77,6 +88,7 @@ impl Default for AggregatorOptions {
             bounds: BoundsConfig::default(),
             representation: Representation::default(),
             average_lessons: true,
+            follow_user_speed: true,
         }
     }
 }
@@ -93,6 +105,7 @@ impl AggregatorOptions {
             use_zone: true,
             representation: Representation::TimeIndexed,
             average_lessons: false,
+            follow_user_speed: false,
             ..AggregatorOptions::default()
         }
     }

@@ -188,7 +188,7 @@ mod tests {
             [[rungs]]
             name = "rest"
             change = "the rest of palc"
-            aggregator = { learnable_rows = ["w1", "w2"], correction = { rule = "target" }, use_zone = false, representation = "relative-onset", average_lessons = true }
+            aggregator = { learnable_rows = ["w1", "w2"], correction = { rule = "target" }, use_zone = false, representation = "relative-onset", average_lessons = true, follow_user_speed = true }
             "#,
         )
         .unwrap();

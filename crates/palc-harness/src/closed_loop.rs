@@ -34,7 +34,7 @@
 //! exactly as in open loop, so that lessons are labelled the same way.
 
 use palc_aggregator::{AggregatorOptions, Experience, plan_problem};
-use palc_planner::{Plan, Planner, PlannerConfig, Position, State, Weights, features};
+use palc_planner::{Plan, Planner, PlannerConfig, Position, State, Terminal, Weights, features};
 use palc_traffic::Scene;
 use palc_zone_filter::StepScene;
 use serde::{Deserialize, Serialize};
@@ -158,6 +158,9 @@ pub struct ClosedLoop {
     /// The standard ALC's weights at the scenario's horizon, when the safety layer
     /// is on (the fallback).
     standard: Option<Weights>,
+    /// The reference speeds (`K`) and the terminal condition the plans follow, when
+    /// not the scenario's ([`ClosedLoop::plan_at_speeds`]).
+    speeds: Option<(Vec<f64>, Terminal)>,
 }
 
 /// One re-plan's result: the plan, or why the ego keeps the current one.
@@ -194,7 +197,16 @@ impl ClosedLoop {
             planner,
             period,
             standard,
+            speeds: None,
         })
+    }
+
+    /// Re-plans with `reference_speed` (one per step of the scenario's horizon) and
+    /// `terminal` instead of the scenario's speeds: those the learning loop's plans
+    /// follow once they have learned the user's
+    /// ([`AggregatorOptions::follow_user_speed`]).
+    pub fn plan_at_speeds(&mut self, reference_speed: &[f64], terminal: Terminal) {
+        self.speeds = Some((reference_speed.to_vec(), terminal));
     }
 
     /// The closed-loop driver of `config` in the scenario of `setup`, planning with
@@ -349,6 +361,12 @@ impl ClosedLoop {
         let remaining = k - step;
         let (preceding, adjacent) = predict(setup, scene, tail)?;
         let mut template = problem(setup, experience.weights.clone(), Vec::new());
+        if let Some((reference_speed, terminal)) = &self.speeds {
+            if reference_speed.len() == template.reference_speed.len() {
+                template.reference_speed.copy_from_slice(reference_speed);
+                template.terminal = *terminal;
+            }
+        }
         template.initial = tail[0];
         template.reference_speed.drain(..step);
         template.preceding = (preceding[..remaining].iter())

@@ -72,6 +72,10 @@ pub struct Drive {
     pub safety: SafetyMetrics,
     /// Safety of the steps the user drove after a takeover (default without one).
     pub user_safety: SafetyMetrics,
+    /// Whether the user, after a takeover, drove at another acceleration than the
+    /// ego's ACC would have at some step: a speed of its own, which the plans can
+    /// learn ([`palc_aggregator::AggregatorOptions::follow_user_speed`]).
+    pub user_speed_differs: bool,
 }
 
 /// The first step at which `user`, expecting `expectation`, takes over the ego
@@ -124,6 +128,7 @@ pub fn execute(
     let frame = |p: Option<&palc_traffic::Vehicle>| {
         p.map_or([1e4, 0.0], |v| [v.state.s - setup.origin_s, v.state.l])
     };
+    let mut user_speed_differs = false;
     for i in 0..=k {
         let by_user = takeover_step.is_some_and(|step| i >= step);
         let state = match (by_user, driven.last()) {
@@ -142,6 +147,8 @@ pub fn execute(
                 );
                 let acceleration =
                     user.acceleration_after_takeover(expectation, i, previous.v, acc);
+                // Exact: a user who leaves its speed to the ACC returns its command.
+                user_speed_differs |= acceleration != acc;
                 let moved = ballistic_step(previous.v, acceleration, dt);
                 State {
                     s: previous.s + moved.distance,
@@ -207,6 +214,7 @@ pub fn execute(
         perceived_safety_ratio,
         safety: system.metrics(),
         user_safety: by_user_monitor.metrics(),
+        user_speed_differs,
     })
 }
 

@@ -393,6 +393,32 @@ impl LearningLoop {
         Ok((drive, ceiling))
     }
 
+    /// `follow_user_speed`, for a user who drove at a speed of its own after taking
+    /// over at `takeover_step` in `drive` (another acceleration than the ego's ACC
+    /// would have commanded): the plans from now on move along the road as the
+    /// user did. Their reference speed from that step on, and their terminal speed
+    /// (and, under the ACC, terminal station) are the user's; before it, the
+    /// scenario's.
+    fn follow_user_speed(&mut self, drive: &Drive, takeover_step: usize) {
+        let template = &mut self.template;
+        let from = takeover_step.min(template.reference_speed.len());
+        for (reference, state) in template.reference_speed[from..]
+            .iter_mut()
+            .zip(&drive.driven[from..])
+        {
+            *reference = state.v;
+        }
+        if let Some(end) = drive.driven.get(template.reference_speed.len()) {
+            template.terminal.v = end.v;
+            if template.terminal.s.is_some() {
+                template.terminal.s = Some(end.s);
+            }
+        }
+        if let Some(driver) = &mut self.closed_loop {
+            driver.plan_at_speeds(&template.reference_speed, template.terminal);
+        }
+    }
+
     /// The record of a driven lane change.
     fn record(&self, drive: &Drive, nominal_plan_taken_over: bool) -> LaneChangeRecord {
         LaneChangeRecord {
@@ -447,6 +473,12 @@ impl LearningLoop {
             for (state, l) in lesson.executed.iter_mut().zip(mean) {
                 state.l = l;
             }
+        }
+        // Under the safety layer the ego's speed is the ACC's that keeps the safe
+        // distance, which a learned speed must not override.
+        if self.options.follow_user_speed && drive.user_speed_differs && !self.setup.safety.enforce
+        {
+            self.follow_user_speed(drive, takeover_step);
         }
         let result: Result<StepOutcome, AggregatorError> = learn_from_lesson(
             &mut self.planner,

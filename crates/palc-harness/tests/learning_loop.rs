@@ -305,3 +305,57 @@ fn averaging_lessons_changes_nothing_for_a_user_who_repeats_the_lane_change() {
         );
     }
 }
+
+/// `follow_user_speed`: a user who slows to the target lane's speed once it has
+/// started takes over the first lane change and drives at its own speed; the
+/// next plan slows down with it from the takeover on, to the speed the user
+/// ended at, while without the option it keeps the scenario's speed. A user who
+/// keeps the scenario's speed leaves the plans as they were.
+#[test]
+fn the_plans_follow_the_speed_the_user_drove() {
+    let slowing = |follow_user_speed: bool| {
+        let mut config = config(Method::Palc, "neutral");
+        config.user = UserConfig::from_toml_str(
+            "[user]\nstyle = \"neutral\"\nfamily = { speed = { rule = \"accelerating\", max_acceleration_mps2 = 1.5 } }",
+            config.planning.takeover_threshold_m,
+        )
+        .unwrap();
+        config.aggregator = Some(palc_aggregator::AggregatorOptions {
+            follow_user_speed,
+            ..Method::Palc.aggregator_options()
+        });
+        let mut run = palc_harness::LearningLoop::new(&config, None).unwrap();
+        let first = run.step(&mut NoObserver).unwrap().clone();
+        let takeover = first
+            .takeover
+            .expect("the standard ALC's plan is taken over");
+        (run.next_plan().clone(), takeover.step)
+    };
+    let ((followed, step), (kept, _)) = (slowing(true), slowing(false));
+    let scenario_speed = kept.states[0].v;
+    let end = |plan: &palc_planner::Plan| plan.states.last().unwrap().v;
+    assert!((end(&kept) - scenario_speed).abs() < 1e-3, "{}", end(&kept));
+    assert!(
+        end(&followed) < scenario_speed - 1.0,
+        "ends at {} m/s, the scenario at {scenario_speed}",
+        end(&followed)
+    );
+    // Before the takeover the two plans move alike.
+    let before = step.saturating_sub(20);
+    assert!((followed.states[before].v - kept.states[before].v).abs() < 0.2);
+
+    // A user at the scenario's speed: the same plans with and without the option.
+    let keeping = |follow_user_speed: bool| {
+        let mut config = config(Method::Palc, "neutral");
+        config.aggregator = Some(palc_aggregator::AggregatorOptions {
+            follow_user_speed,
+            ..Method::Palc.aggregator_options()
+        });
+        learn(&config)
+    };
+    let (a, b) = (keeping(true), keeping(false));
+    assert_eq!(a.summary.takeovers, b.summary.takeovers);
+    for (x, y) in a.records.iter().zip(&b.records) {
+        assert_eq!(x.planned_l, y.planned_l);
+    }
+}
