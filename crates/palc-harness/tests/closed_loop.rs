@@ -205,3 +205,54 @@ fn a_closed_loop_run_records_its_replans_and_round_trips() {
     let old: palc_harness::LaneChangeRecord = serde_json::from_value(value).unwrap();
     assert_eq!(old.closed_loop, None);
 }
+
+/// `ClosedLoop::plan_at_speeds`: the re-plans follow the speeds the learning loop's
+/// plans follow (a user's, with `follow_user_speed`), not the scenario's.
+#[test]
+fn the_replans_follow_the_speeds_they_are_given() {
+    let planning = PlanningConfig::default();
+    let setup = Setup::new(&scripted_scene(), &planning, "scripted").unwrap();
+    let (k, dt) = (setup.horizon, setup.dt);
+    let standard = setup.standard_lane_change(&planning.standard_alc);
+    let weights = StandardWeights::default().weights(&standard, k, dt);
+    let experience = Experience::new("aggressive", "scripted", "palc", weights, dt).unwrap();
+    let options = AggregatorOptions::default();
+    let planner_config = PlannerConfig {
+        horizon: k,
+        dt,
+        ..PlannerConfig::default()
+    };
+    let mut planner = Planner::new(planner_config.clone()).unwrap();
+    let template = problem(&setup, experience.weights.clone(), Vec::new());
+    let (first, _) = plan_problem(&planner, &experience, &template, &[], &options).unwrap();
+    let plan = planner.plan(&first).unwrap();
+    let scenario_speed = template.terminal.v;
+    // 2 m/s slower by the middle of the horizon, as a user who slows down.
+    let slower: Vec<f64> = (0..k)
+        .map(|i| scenario_speed - 2.0 * (2.0 * i as f64 / k as f64).min(1.0))
+        .collect();
+    let terminal = palc_planner::Terminal {
+        v: scenario_speed - 2.0,
+        ..template.terminal
+    };
+    let end_speed = |driver: &ClosedLoop| {
+        let (driven, stats) = driver
+            .drive(&setup, &experience, &options, &plan, false)
+            .unwrap();
+        assert_eq!(stats.replan_failures, 0);
+        driven.states.last().unwrap().v
+    };
+    let scenario = ClosedLoop::new(planner_config.clone(), 1, None).unwrap();
+    let mut following = ClosedLoop::new(planner_config, 1, None).unwrap();
+    following.plan_at_speeds(&slower, terminal);
+    let (kept, followed) = (end_speed(&scenario), end_speed(&following));
+    assert!(
+        (kept - scenario_speed).abs() < 0.1,
+        "{kept} vs {scenario_speed}"
+    );
+    assert!(
+        (followed - terminal.v).abs() < 0.1,
+        "{followed} vs {}",
+        terminal.v
+    );
+}
