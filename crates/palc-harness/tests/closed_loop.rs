@@ -59,8 +59,16 @@ fn scripted_scene() -> Scene {
     .unwrap()
 }
 
-#[test]
-fn with_exact_predictions_the_closed_loop_sees_the_open_loop_takeover() {
+/// The scripted scene's set-up, the standard ALC's weights as an experience,
+/// `palc`'s options, the planner's config, the problem template and its plan.
+fn standard_plan() -> (
+    Setup,
+    Experience,
+    AggregatorOptions,
+    PlannerConfig,
+    palc_planner::Problem,
+    palc_planner::Plan,
+) {
     let planning = PlanningConfig::default();
     let setup = Setup::new(&scripted_scene(), &planning, "scripted").unwrap();
     let (k, dt) = (setup.horizon, setup.dt);
@@ -68,20 +76,27 @@ fn with_exact_predictions_the_closed_loop_sees_the_open_loop_takeover() {
     let weights = StandardWeights::default().weights(&standard, k, dt);
     let experience = Experience::new("aggressive", "scripted", "palc", weights, dt).unwrap();
     let options = AggregatorOptions::default();
-    let mut planner = Planner::new(PlannerConfig {
+    let config = PlannerConfig {
         horizon: k,
         dt,
         ..PlannerConfig::default()
-    })
-    .unwrap();
+    };
+    let mut planner = Planner::new(config.clone()).unwrap();
     let template = problem(&setup, experience.weights.clone(), Vec::new());
     let (first, _) = plan_problem(&planner, &experience, &template, &[], &options).unwrap();
     let plan = planner.plan(&first).unwrap();
+    (setup, experience, options, config, template, plan)
+}
+
+#[test]
+fn with_exact_predictions_the_closed_loop_sees_the_open_loop_takeover() {
+    let (setup, experience, options, planner, _, plan) = standard_plan();
+    let k = setup.horizon;
     let user = SimulatedUser::paper(StylePreset::Aggressive.style()).unwrap();
     let expected = user.nominal(&setup).unwrap();
 
     let open = execute(&setup, plan.clone(), &user, &expected).unwrap();
-    let driver = ClosedLoop::new(planner.config().clone(), 1, None).unwrap();
+    let driver = ClosedLoop::new(planner, 1, None).unwrap();
     let (driven, stats) = driver
         .drive(&setup, &experience, &options, &plan, false)
         .unwrap();
@@ -210,22 +225,8 @@ fn a_closed_loop_run_records_its_replans_and_round_trips() {
 /// plans follow (a user's, with `follow_user_speed`), not the scenario's.
 #[test]
 fn the_replans_follow_the_speeds_they_are_given() {
-    let planning = PlanningConfig::default();
-    let setup = Setup::new(&scripted_scene(), &planning, "scripted").unwrap();
-    let (k, dt) = (setup.horizon, setup.dt);
-    let standard = setup.standard_lane_change(&planning.standard_alc);
-    let weights = StandardWeights::default().weights(&standard, k, dt);
-    let experience = Experience::new("aggressive", "scripted", "palc", weights, dt).unwrap();
-    let options = AggregatorOptions::default();
-    let planner_config = PlannerConfig {
-        horizon: k,
-        dt,
-        ..PlannerConfig::default()
-    };
-    let mut planner = Planner::new(planner_config.clone()).unwrap();
-    let template = problem(&setup, experience.weights.clone(), Vec::new());
-    let (first, _) = plan_problem(&planner, &experience, &template, &[], &options).unwrap();
-    let plan = planner.plan(&first).unwrap();
+    let (setup, experience, options, planner_config, template, plan) = standard_plan();
+    let k = setup.horizon;
     let scenario_speed = template.terminal.v;
     // 2 m/s slower by the middle of the horizon, as a user who slows down.
     let slower: Vec<f64> = (0..k)
