@@ -205,8 +205,40 @@ impl ClosedLoop {
     /// `terminal` instead of the scenario's speeds: those the learning loop's plans
     /// follow once they have learned the user's
     /// ([`AggregatorOptions::follow_user_speed`]).
-    pub fn plan_at_speeds(&mut self, reference_speed: &[f64], terminal: Terminal) {
+    ///
+    /// # Errors
+    /// [`HarnessError::InvalidConfig`] for a reference of another length than the
+    /// planner's horizon, or a speed that is not finite and non-negative.
+    pub fn plan_at_speeds(
+        &mut self,
+        reference_speed: &[f64],
+        terminal: Terminal,
+    ) -> Result<(), HarnessError> {
+        let k = self.planner.horizon;
+        if reference_speed.len() != k {
+            return Err(HarnessError::InvalidConfig {
+                field: "closed_loop.reference_speed".to_owned(),
+                value: reference_speed.len() as f64,
+                bound: format!("one speed per step of the horizon, {k}"),
+            });
+        }
+        let speeds = reference_speed.iter().chain([&terminal.v]).enumerate();
+        if let Some((i, &v)) = speeds
+            .into_iter()
+            .find(|(_, v)| !(v.is_finite() && **v >= 0.0))
+        {
+            return Err(HarnessError::InvalidConfig {
+                field: if i < k {
+                    format!("closed_loop.reference_speed[{i}]")
+                } else {
+                    "closed_loop.terminal.v".to_owned()
+                },
+                value: v,
+                bound: "a finite speed >= 0 m/s".to_owned(),
+            });
+        }
         self.speeds = Some((reference_speed.to_vec(), terminal));
+        Ok(())
     }
 
     /// The closed-loop driver of `config` in the scenario of `setup`, planning with
@@ -362,10 +394,8 @@ impl ClosedLoop {
         let (preceding, adjacent) = predict(setup, scene, tail)?;
         let mut template = problem(setup, experience.weights.clone(), Vec::new());
         if let Some((reference_speed, terminal)) = &self.speeds {
-            if reference_speed.len() == template.reference_speed.len() {
-                template.reference_speed.copy_from_slice(reference_speed);
-                template.terminal = *terminal;
-            }
+            template.reference_speed.clone_from(reference_speed);
+            template.terminal = *terminal;
         }
         template.initial = tail[0];
         template.reference_speed.drain(..step);

@@ -399,7 +399,11 @@ impl LearningLoop {
     /// user did. Their reference speed from that step on, and their terminal speed
     /// (and, under the ACC, terminal station) are the user's; before it, the
     /// scenario's.
-    fn follow_user_speed(&mut self, drive: &Drive, takeover_step: usize) {
+    fn follow_user_speed(
+        &mut self,
+        drive: &Drive,
+        takeover_step: usize,
+    ) -> Result<(), HarnessError> {
         let template = &mut self.template;
         let from = takeover_step.min(template.reference_speed.len());
         for (reference, state) in template.reference_speed[from..]
@@ -415,8 +419,9 @@ impl LearningLoop {
             }
         }
         if let Some(driver) = &mut self.closed_loop {
-            driver.plan_at_speeds(&template.reference_speed, template.terminal);
+            driver.plan_at_speeds(&template.reference_speed, template.terminal)?;
         }
+        Ok(())
     }
 
     /// The record of a driven lane change.
@@ -478,7 +483,7 @@ impl LearningLoop {
         // distance, which a learned speed must not override.
         if self.options.follow_user_speed && drive.user_speed_differs && !self.setup.safety.enforce
         {
-            self.follow_user_speed(drive, takeover_step);
+            self.follow_user_speed(drive, takeover_step)?;
         }
         let result: Result<StepOutcome, AggregatorError> = learn_from_lesson(
             &mut self.planner,

@@ -245,7 +245,22 @@ fn the_replans_follow_the_speeds_they_are_given() {
     };
     let scenario = ClosedLoop::new(planner_config.clone(), 1, None).unwrap();
     let mut following = ClosedLoop::new(planner_config, 1, None).unwrap();
-    following.plan_at_speeds(&slower, terminal);
+    following.plan_at_speeds(&slower, terminal).unwrap();
+    // A reference of another length, or a speed that is not one, is refused.
+    let err = following
+        .plan_at_speeds(&slower[1..], terminal)
+        .unwrap_err();
+    assert!(
+        err.to_string().contains("closed_loop.reference_speed"),
+        "{err}"
+    );
+    let mut nan = slower.clone();
+    nan[3] = f64::NAN;
+    let err = following.plan_at_speeds(&nan, terminal).unwrap_err();
+    assert!(
+        err.to_string().contains("closed_loop.reference_speed[3]"),
+        "{err}"
+    );
     let (kept, followed) = (end_speed(&scenario), end_speed(&following));
     assert!(
         (kept - scenario_speed).abs() < 0.1,
