@@ -23,7 +23,9 @@
 //! emergency limit (an automatic emergency brake). Under the safety layer the ACC
 //! also keeps the RSS safe distance ([`AccConfig::acceleration_keeping`]): closing
 //! within it (plus [`SAFE_DISTANCE_LEAD_S`] of closing speed), it brakes at RSS's
-//! `b_min`.
+//! `b_min`. While a plan or the user drives the ego, the same law without its
+//! cruise term caps their acceleration (the longitudinal guard, `guard.rs`,
+//! [`AccConfig::guard`]), with the ACC on or off.
 
 use palc_traffic::{Driver, Scene};
 use serde::{Deserialize, Serialize};
@@ -65,6 +67,11 @@ pub struct AccConfig {
     /// Behind a vehicle as slow as the target lane, an ego that only follows it would
     /// keep its place beside the same target-lane vehicles for ever.
     pub gap_seeking_speed_mps: f64,
+    /// Whether the ACC's following law also limits the ego's acceleration while a
+    /// plan or the user drives it (the longitudinal guard, `guard.rs`): on by
+    /// default, with the ACC on or off, so that no lane change drives into the
+    /// vehicle ahead. Off, a plan is driven as planned (the paper's execution).
+    pub guard: bool,
 }
 
 impl Default for AccConfig {
@@ -80,6 +87,7 @@ impl Default for AccConfig {
             comfort_deceleration_mps2: 3.0,
             emergency_deceleration_mps2: 8.0,
             gap_seeking_speed_mps: 2.0,
+            guard: true,
         }
     }
 }
@@ -156,23 +164,32 @@ impl AccConfig {
         let Some((gap, leader_v)) = leader else {
             return cruise.clamp(-self.comfort_deceleration_mps2, self.max_acceleration_mps2);
         };
-        let follow = self.gap_gain * (gap - self.standstill_gap_m - self.time_gap_s * v)
-            + self.speed_gain * (leader_v - v);
+        let follow = self.following(v, gap, leader_v);
         let comfortable = follow
             .min(cruise)
             .clamp(-self.comfort_deceleration_mps2, self.max_acceleration_mps2);
+        self.emergency(v, gap, leader_v).unwrap_or(comfortable)
+    }
+
+    /// The time-gap law `k_s (g − s_0 − T v) + k_v (v_l − v)`, unclamped.
+    pub(crate) fn following(&self, v: f64, gap: f64, leader_v: f64) -> f64 {
+        self.gap_gain * (gap - self.standstill_gap_m - self.time_gap_s * v)
+            + self.speed_gain * (leader_v - v)
+    }
+
+    /// The emergency branch: when closing so fast that the comfortable deceleration
+    /// cannot match the leader's speed before the standstill gap, the kinematic
+    /// deceleration that does, up to the emergency limit; `None` otherwise.
+    pub(crate) fn emergency(&self, v: f64, gap: f64, leader_v: f64) -> Option<f64> {
         let closing = v - leader_v;
         if closing <= 0.0 {
-            return comfortable;
+            return None;
         }
         // The deceleration that matches the leader's speed just at the standstill gap.
         let room = (gap - self.standstill_gap_m).max(1e-3);
         let needed = closing * closing / (2.0 * room);
-        if needed > self.comfort_deceleration_mps2 {
-            -needed.min(self.emergency_deceleration_mps2)
-        } else {
-            comfortable
-        }
+        (needed > self.comfort_deceleration_mps2)
+            .then(|| -needed.min(self.emergency_deceleration_mps2))
     }
 }
 

@@ -42,6 +42,7 @@ use serde::{Deserialize, Serialize};
 use crate::HarnessError;
 use crate::config::LearnConfig;
 use crate::drive::{ego_state, problem};
+use crate::guard::{drive_states, guarded_step};
 use crate::safety::{SafetyMetrics, SafetyMonitor, Violation};
 use crate::setup::Setup;
 
@@ -303,7 +304,14 @@ impl ClosedLoop {
             let until = (step + self.period).min(k);
             for i in step..until {
                 let j = i - start;
-                let next = current.states[j + 1];
+                let previous = states.last().copied().unwrap_or(current.states[j]);
+                let next = guarded_step(
+                    setup,
+                    &scene,
+                    &previous,
+                    &current.states[j],
+                    &current.states[j + 1],
+                );
                 controls.push(current.controls[j]);
                 states.push(next);
                 lateral_violation
@@ -315,7 +323,13 @@ impl ClosedLoop {
             if k - step < 2 {
                 continue;
             }
-            let tail = &current.states[step - start..];
+            // The rest of the current plan, from the state driven (the plan's own
+            // unless the longitudinal guard held the ego back).
+            let mut tail = current.states[step - start..].to_vec();
+            if let (Some(first), Some(&driven)) = (tail.first_mut(), states.last()) {
+                *first = driven;
+            }
+            let tail = &tail[..];
             let mut outcome =
                 self.replan(setup, experience, options, &scene, tail, step, policy)?;
             stats.replans += 1;
@@ -499,10 +513,9 @@ fn safety_from(
     // The monitor of the whole lane change: its start lane and preceding vehicle
     // are those at the trigger.
     let mut monitor = SafetyMonitor::new(setup.safety, &setup.scene, setup.target_l);
-    monitor.observe(step, &rollout);
-    for (i, state) in states.iter().enumerate().skip(1) {
-        rollout.step(setup.dt, ego_state(setup, state))?;
-        monitor.observe(step + i, &rollout);
-    }
+    drive_states(setup, &mut rollout, states, |i, _, scene| {
+        monitor.observe(step + i, scene);
+        false
+    })?;
     Ok(monitor.metrics())
 }

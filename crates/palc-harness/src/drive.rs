@@ -5,6 +5,7 @@ use palc_traffic::{EgoState, ballistic_step};
 
 use crate::HarnessError;
 use crate::acc::acc_leader;
+use crate::guard::{drive_states, guarded_step, guarded_user_acceleration};
 use crate::record::Takeover;
 use crate::safety::{SafetyMetrics, SafetyMonitor};
 use crate::setup::{Setup, situation};
@@ -90,15 +91,14 @@ pub fn judge(
     states: &[State],
 ) -> Result<Option<(usize, TakeoverCause)>, HarnessError> {
     let mut scene = setup.scene.clone();
-    for (i, state) in states.iter().enumerate() {
-        if i > 0 {
-            scene.step(setup.dt, ego_state(setup, state))?;
-        }
-        if let Some(cause) = user.takes_over(expectation, i, state, &situation(&scene)) {
-            return Ok(Some((i, cause)));
-        }
-    }
-    Ok(None)
+    let mut judged = None;
+    drive_states(setup, &mut scene, states, |i, driven, scene| {
+        judged = user
+            .takes_over(expectation, i, driven, &situation(scene))
+            .map(|cause| (i, cause));
+        judged.is_some()
+    })?;
+    Ok(judged)
 }
 
 /// Drives `plan` in a clone of the scene; `user`, expecting `expectation`, judges
@@ -132,7 +132,14 @@ pub fn execute(
     for i in 0..=k {
         let by_user = takeover_step.is_some_and(|step| i >= step);
         let state = match (by_user, driven.last()) {
-            (false, _) => plan.states[i],
+            (false, None) => plan.states[0],
+            (false, Some(previous)) => guarded_step(
+                setup,
+                &scene,
+                previous,
+                &plan.states[i - 1],
+                &plan.states[i],
+            ),
             (true, None) => State {
                 l: expected_l[0],
                 ..plan.states[0]
@@ -149,6 +156,8 @@ pub fn execute(
                     user.acceleration_after_takeover(expectation, i, previous.v, acc);
                 // Exact: a user who leaves its speed to the ACC returns its command.
                 user_speed_differs |= acceleration != acc;
+                let acceleration =
+                    guarded_user_acceleration(setup, &scene, previous.v, acceleration);
                 let moved = ballistic_step(previous.v, acceleration, dt);
                 State {
                     s: previous.s + moved.distance,
@@ -222,13 +231,21 @@ pub fn execute(
 /// vehicles reacting as the simulation moves them: the prediction that the safety
 /// layer checks before the ego drives a plan.
 pub fn plan_safety(setup: &Setup, plan: &Plan) -> Result<SafetyMetrics, HarnessError> {
+    states_safety(setup, &plan.states)
+}
+
+/// The safety of `states` (plan frame, from the trigger) driven by the system to
+/// their end in a clone of the scene, under the longitudinal guard.
+pub(crate) fn states_safety(
+    setup: &Setup,
+    states: &[State],
+) -> Result<SafetyMetrics, HarnessError> {
     let mut scene = setup.scene.clone();
     let mut monitor = SafetyMonitor::new(setup.safety, &scene, setup.target_l);
-    monitor.observe(0, &scene);
-    for (i, state) in plan.states.iter().enumerate().skip(1) {
-        scene.step(setup.dt, ego_state(setup, state))?;
-        monitor.observe(i, &scene);
-    }
+    drive_states(setup, &mut scene, states, |i, _, scene| {
+        monitor.observe(i, scene);
+        false
+    })?;
     Ok(monitor.metrics())
 }
 

@@ -16,7 +16,7 @@ use crate::HarnessError;
 use crate::carry::{rehearse, starting_experience};
 use crate::closed_loop::ClosedLoop;
 use crate::config::{LearnConfig, StoppingConfig};
-use crate::drive::{Drive, execute, judge, plan_safety, problem};
+use crate::drive::{Drive, execute, judge, plan_safety, problem, states_safety};
 use crate::learn::{RunResult, aggregator_options, prepare_for};
 use crate::lesson::{lesson, scenes, zone_feature_set};
 use crate::method::Method;
@@ -125,6 +125,23 @@ impl LearningLoop {
                     user.name()
                 ),
             });
+        }
+        // Under the longitudinal guard, the user's own lane change driven in the
+        // scene must not collide: a scene in which it does has no sane lane change
+        // for this user (without the guard, the paper's constant speeds run most of
+        // them into the slower target-lane vehicle, and the scene is driven as is).
+        if setup.acc.guard {
+            let own = states_safety(&setup, &nominal.states[..=setup.horizon])?;
+            if own.collision {
+                return Err(HarnessError::Scenario {
+                    scenario: config.label(),
+                    reason: format!(
+                        "the lane change user `{}` expects collides in this scene ({})",
+                        user.name(),
+                        collided_with(&own)
+                    ),
+                });
+            }
         }
         let options = aggregator_options(config);
         options.validate()?;
@@ -617,6 +634,26 @@ fn success(records: &[LaneChangeRecord], streak: usize, stopping: &StoppingConfi
     let taken = window.iter().filter(|r| r.takeover.is_some()).count() as f64 / n;
     let ceiling = window.iter().filter(|r| r.nominal_plan_taken_over).count() as f64 / n;
     taken <= ceiling + stopping.spread_margin
+}
+
+/// The vehicles a collision of `metrics` overlapped, with their smallest net gap.
+fn collided_with(metrics: &SafetyMetrics) -> String {
+    let roles = [
+        ("the preceding vehicle", metrics.min_gap_preceding_m),
+        ("the target lane's lead", metrics.min_gap_target_lead_m),
+        ("the target lane's lag", metrics.min_gap_target_lag_m),
+    ];
+    let overlapped: Vec<String> = (roles.iter())
+        .filter_map(|(role, gap)| {
+            gap.filter(|g| *g <= 0.0)
+                .map(|g| format!("{role} at {g:.1} m"))
+        })
+        .collect();
+    if overlapped.is_empty() {
+        "another vehicle".to_owned()
+    } else {
+        overlapped.join(", ")
+    }
 }
 
 #[cfg(test)]

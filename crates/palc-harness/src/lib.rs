@@ -36,6 +36,7 @@ pub mod closed_loop;
 mod config;
 mod drive;
 mod error;
+mod guard;
 mod learn;
 mod learning_loop;
 mod lesson;

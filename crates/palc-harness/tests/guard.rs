@@ -1,0 +1,119 @@
+//! The longitudinal guard (`[planning.acc] guard`) in a scene of the paper's grid
+//! where lane changes at the paper's constant speed drive into the slower
+//! target-lane vehicle they moved in behind: with the guard the ego brakes behind
+//! it, the lateral path and the learning stay those of the plan.
+
+use palc_harness::{CellChoice, LearnConfig, Method, NoObserver, RunResult, UserConfig, run};
+
+/// collector-high / 35 m / seed 1, an aggressive user, the paper's set-up (ACC
+/// off, no safety layer): the user's lane change and the plans that learn it
+/// move in 0.5 s behind a target-lane vehicle 2.2 m/s slower than the ego.
+fn config(guard: bool, closed_loop: bool) -> LearnConfig {
+    let text = include_str!("../../../configs/learn.toml");
+    let mut config = LearnConfig::from_toml_str(text)
+        .expect("the default config parses")
+        .with_method(Method::Palc)
+        .with_cell(CellChoice {
+            speed_case: "collector-high".to_owned(),
+            headway_m: 35.0,
+            seed: 1,
+        });
+    config = config.clone().with_user(UserConfig {
+        style: "aggressive".parse().expect("a preset"),
+        ..config.user
+    });
+    config.planning.acc.guard = guard;
+    config.planning.closed_loop.enabled = closed_loop;
+    config
+}
+
+fn learn(config: &LearnConfig) -> RunResult {
+    run(config, None, &mut NoObserver).expect("the scenario runs")
+}
+
+#[test]
+fn without_the_guard_the_scene_drives_into_the_target_lane_vehicle() {
+    let result = learn(&config(false, false));
+    assert!(
+        result.records.iter().any(|r| r.safety.collision),
+        "the scene no longer shows what the guard is for: {:?}",
+        result.records.iter().map(|r| &r.safety).collect::<Vec<_>>()
+    );
+}
+
+#[test]
+fn with_the_guard_no_lane_change_collides_and_the_learning_is_the_same() {
+    let (without, with) = (learn(&config(false, false)), learn(&config(true, false)));
+    for record in &with.records {
+        assert!(
+            !record.safety.collision && !record.user_safety.collision,
+            "lane change {}: {:?} / {:?}",
+            record.index,
+            record.safety,
+            record.user_safety
+        );
+    }
+    // The guard changes the speed along the road, not the lateral path the user
+    // judges: the same takeovers, plans and driven lateral positions.
+    assert_eq!(with.summary.outcome, without.summary.outcome);
+    assert_eq!(with.records.len(), without.records.len());
+    for (a, b) in with.records.iter().zip(&without.records) {
+        assert_eq!(a.takeover, b.takeover, "lane change {}", a.index);
+        assert_eq!(a.planned_l, b.planned_l, "lane change {}", a.index);
+        assert_eq!(a.driven_l, b.driven_l, "lane change {}", a.index);
+    }
+    // It braked: the smallest gap to the target lane's leader is positive with it.
+    let lead_gap = |r: &RunResult| {
+        (r.records.iter())
+            .filter_map(|x| x.safety.min_gap_target_lead_m)
+            .fold(f64::INFINITY, f64::min)
+    };
+    assert!(lead_gap(&with) > 0.0, "{}", lead_gap(&with));
+    assert!(lead_gap(&without) < 0.0, "{}", lead_gap(&without));
+}
+
+#[test]
+fn the_closed_loop_is_guarded_too() {
+    let result = learn(&config(true, true));
+    for record in &result.records {
+        assert!(
+            !record.safety.collision && !record.user_safety.collision,
+            "lane change {}: {:?}",
+            record.index,
+            record.safety
+        );
+    }
+    assert!(
+        learn(&config(false, true))
+            .records
+            .iter()
+            .any(|r| r.safety.collision)
+    );
+}
+
+/// A user who starts only when the time to collision with the preceding vehicle
+/// falls to 8 s waits, in collector-high / 35 m / seed 1, until the ego has nearly
+/// reached it; the guard's emergency brake then holds the ego back, and the user's
+/// own lane change cuts in just ahead of the target lane's lag. Under the guard
+/// such a scene is refused, naming the vehicle, rather than run through.
+#[test]
+fn a_scene_where_the_users_own_lane_change_collides_is_refused() {
+    let mut config = config(true, false);
+    config.user.family = Some(
+        toml::from_str(r#"start = { rule = "time-to-collision", seconds = 8.0 }"#)
+            .expect("a family table"),
+    );
+    let Err(error) = palc_harness::LearningLoop::new(&config, None) else {
+        panic!("the scene is refused");
+    };
+    let message = error.to_string();
+    assert!(
+        message.contains("collector-high / 35 m / seed 1"),
+        "{message}"
+    );
+    assert!(message.contains("collides"), "{message}");
+    assert!(message.contains("the target lane's lag"), "{message}");
+    // Without the guard the same scene runs (and drives through vehicles).
+    config.planning.acc.guard = false;
+    assert!(palc_harness::LearningLoop::new(&config, None).is_ok());
+}
