@@ -22,8 +22,13 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
          `[planning.safety]`). *System* counts the steps the system drove (the plan up to a \
          takeover); *user* the steps the simulated user drove after a takeover. The safety layer \
          checks every plan before it is driven and drives the standard ALC's plan instead of an \
-         unsafe one (a refusal), when the config turns it on (`planning.safety.enforce`). The \
-         paper's set-up holds every speed constant and has no safety layer; \
+         unsafe one (a refusal), when the config turns it on (`planning.safety.enforce`). \
+         Whatever drives the ego (plan, re-plan or user), the longitudinal guard \
+         (`planning.acc.guard`, on by default) caps its acceleration by the ACC's law behind \
+         the vehicle ahead in a lane it moves into and by the ACC's emergency brake in its \
+         own lane; the lateral path stays the driver's (docs/paper-mapping.md, \"The \
+         longitudinal guard\"). The paper's set-up otherwise holds every speed constant and \
+         has no safety layer; \
          `configs/reproduce-safe.toml` is the same evaluation with the ego's ACC, the safety layer \
          and users who start only into gaps at the safe distance (`cargo xtask reproduce-paper` \
          writes its report to `safe/REPORT.md`, and the stress scenes of `configs/stress/` under \
