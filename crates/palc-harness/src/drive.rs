@@ -129,8 +129,22 @@ pub fn execute(
         p.map_or([1e4, 0.0], |v| [v.state.s - setup.origin_s, v.state.l])
     };
     let mut user_speed_differs = false;
+    // Where the system had driven the ego when the user took over: the plan's
+    // state there, unless the longitudinal guard held the ego back.
+    let mut at_takeover = plan.states[0];
     for i in 0..=k {
         let by_user = takeover_step.is_some_and(|step| i >= step);
+        if let (Some(step), Some(previous)) = (takeover_step, driven.last()) {
+            if i == step {
+                at_takeover = guarded_step(
+                    setup,
+                    &scene,
+                    previous,
+                    &plan.states[i - 1],
+                    &plan.states[i],
+                );
+            }
+        }
         let state = match (by_user, driven.last()) {
             (false, None) => plan.states[0],
             (false, Some(previous)) => guarded_step(
@@ -190,7 +204,7 @@ pub fn execute(
     let takeover = judged.map(|(step, cause)| Takeover {
         step,
         time_s: step as f64 * dt,
-        distance_m: plan.states[step].s,
+        distance_m: at_takeover.s,
         deviation_m: (planned_l[step] - expected_l[step]).abs(),
         cause,
     });
