@@ -134,26 +134,22 @@ pub fn execute(
     let mut at_takeover = plan.states[0];
     for i in 0..=k {
         let by_user = takeover_step.is_some_and(|step| i >= step);
-        if let (Some(step), Some(previous)) = (takeover_step, driven.last()) {
-            if i == step {
-                at_takeover = guarded_step(
-                    setup,
-                    &scene,
-                    previous,
-                    &plan.states[i - 1],
-                    &plan.states[i],
-                );
-            }
-        }
-        let state = match (by_user, driven.last()) {
-            (false, None) => plan.states[0],
-            (false, Some(previous)) => guarded_step(
+        // The system's state at this step, while it drives (and at the takeover).
+        let by_system = (takeover_step.is_none_or(|step| i <= step)).then(|| match driven.last() {
+            None => plan.states[0],
+            Some(previous) => guarded_step(
                 setup,
                 &scene,
                 previous,
                 &plan.states[i - 1],
                 &plan.states[i],
             ),
+        });
+        if takeover_step == Some(i) {
+            at_takeover = by_system.unwrap_or(at_takeover);
+        }
+        let state = match (by_user, driven.last()) {
+            (false, _) => by_system.unwrap_or(plan.states[i]),
             (true, None) => State {
                 l: expected_l[0],
                 ..plan.states[0]
