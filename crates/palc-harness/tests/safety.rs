@@ -302,19 +302,26 @@ fn users_who_wait_for_safe_gaps_start_at_the_safe_distance_and_never_earlier() {
                 let Ok((setup, expected)) = expectation(&waiting) else {
                     continue;
                 };
-                let s = &setup.situations[expected.start_step];
-                let v = s.ego_speed;
-                if let (Some(gap), Some(lead_v)) = (s.target_lead_gap_m, s.target_lead_speed) {
-                    assert!(
-                        gap >= safety.safe_distance(v, lead_v),
-                        "{speed_case} {style:?}"
-                    );
-                }
-                if let (Some(gap), Some(lag_v)) = (s.target_lag_gap_m, s.target_lag_speed) {
-                    assert!(
-                        gap >= safety.safe_distance(lag_v, v),
-                        "{speed_case} {style:?}"
-                    );
+                // At every step of the lane change, not only at its start.
+                let end = ((expected.lane_change.end_s() / setup.dt).ceil() as usize)
+                    .min(setup.situations.len() - 1);
+                for (step, s) in setup.situations[expected.start_step..=end]
+                    .iter()
+                    .enumerate()
+                {
+                    let v = s.ego_speed;
+                    if let (Some(gap), Some(lead_v)) = (s.target_lead_gap_m, s.target_lead_speed) {
+                        assert!(
+                            gap >= safety.safe_distance(v, lead_v),
+                            "{speed_case} {style:?}, step {step} of the lane change"
+                        );
+                    }
+                    if let (Some(gap), Some(lag_v)) = (s.target_lag_gap_m, s.target_lag_speed) {
+                        assert!(
+                            gap >= safety.safe_distance(lag_v, v),
+                            "{speed_case} {style:?}, step {step} of the lane change"
+                        );
+                    }
                 }
                 // Waiting only adds a condition: never an earlier start.
                 let Ok((_, unsafe_start)) = expectation(&paper) else {
@@ -328,4 +335,43 @@ fn users_who_wait_for_safe_gaps_start_at_the_safe_distance_and_never_earlier() {
     }
     assert!(compared >= 12, "{compared} cells compared");
     assert!(later > 0, "the condition never held a user back");
+}
+
+/// collector-high / 35 m / seed 1, a cautious user who waits for safe gaps. A start
+/// checked at its first step alone put the user's own lane change 18.6 m behind the
+/// target lane's leader at step 69 (RSS distance 19.9 m) in each of `paper`'s 30
+/// lane changes, and the safety layer refused 29 of `palc`'s plans, which copied it
+/// (30 takeovers, at the cap). Checked over the whole lane change, the user keeps
+/// the safe distance and `palc` learns it in one takeover.
+#[test]
+fn a_user_who_waits_for_safe_gaps_keeps_them_through_its_lane_change() {
+    use palc_harness::{CellChoice, LearnConfig, Method, NoObserver, StylePreset, UserConfig, run};
+
+    let text = include_str!("../../../configs/learn-safe.toml");
+    let config = |method| {
+        LearnConfig::from_toml_str(text)
+            .expect("the safe config parses")
+            .with_method(method)
+            .with_cell(CellChoice {
+                speed_case: "collector-high".into(),
+                headway_m: 35.0,
+                seed: 1,
+            })
+            .with_user(UserConfig::preset(StylePreset::Cautious))
+    };
+    let paper = run(&config(Method::Paper), None, &mut NoObserver).expect("the scene runs");
+    // `paper` takes over in every lane change: the user drives each one itself.
+    assert_eq!(paper.summary.takeovers, paper.records.len());
+    for record in &paper.records {
+        assert_eq!(
+            record.user_safety.rss_violations, 0,
+            "{:?}",
+            record.user_safety
+        );
+        assert_eq!(record.safety.rss_violations, 0, "{:?}", record.safety);
+    }
+    let palc = run(&config(Method::Palc), None, &mut NoObserver).expect("the scene runs");
+    assert_eq!(palc.summary.outcome, palc_harness::Outcome::Personalized);
+    assert_eq!(palc.summary.takeovers, 1);
+    assert!(palc.records.iter().all(|r| r.safety_refusal.is_none()));
 }

@@ -129,11 +129,19 @@ impl SimulatedUser {
             .own_duration_s()
             .unwrap_or(style.lane_change_duration_s);
         // With `users_wait_for_safe_gaps`, the gaps must also be at the RSS safe
-        // distance when the lane change starts (the follower then brakes for the ego,
-        // as RSS's responsibility rule assumes).
+        // distance at every step of the lane change started there, as the user sees
+        // the ego's motion coming (the lane keeping's): a start checked at its first
+        // step alone put the user 18.6 m behind the target lane's leader, below the
+        // 19.9 m RSS distance, at step 69 (collector-high / 35 m / seed 1, cautious),
+        // and the safety layer refused the plans that copied it
+        // (docs/paper-mapping.md, "Users who wait for safe gaps").
         let safety = &setup.safety;
-        let safe =
-            |i: usize| !safety.users_wait_for_safe_gaps || target_gaps_safe(&situations[i], safety);
+        let duration_steps = (duration_s / dt).ceil() as usize;
+        let safe = |i: usize| {
+            !safety.users_wait_for_safe_gaps
+                || (i..=(i + duration_steps).min(window))
+                    .all(|j| target_gaps_safe(&situations[j], safety))
+        };
         let start_step = (earliest..=window)
             .find(|&i| accepting.accepts(&situations[i]) && safe(i))
             .ok_or_else(|| {
@@ -143,7 +151,7 @@ impl SimulatedUser {
                     accepting.min_lead_gap_s,
                     accepting.min_lag_gap_s,
                     if safety.users_wait_for_safe_gaps {
-                        ", and the RSS safe distance"
+                        ", and the RSS safe distance at every step of the lane change"
                     } else {
                         ""
                     }
