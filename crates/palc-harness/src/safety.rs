@@ -40,10 +40,10 @@ pub struct SafetyConfig {
     /// The measures are taken either way.
     pub enforce: bool,
     /// Whether the simulated users of this configuration start their lane change
-    /// only when both target-lane gaps are at least the safe distance below (the
-    /// follower then brakes for the ego, as RSS's responsibility rule assumes),
-    /// besides their style's own gap acceptance: users whose preferred lane change
-    /// is safe. Off by default: the paper's users accept any positive gap behind
+    /// only when both target-lane gaps stay at least the safe distance below at
+    /// every step of the lane change started there (on the ego's lane-keeping
+    /// motion), besides their style's own gap acceptance: users whose preferred
+    /// lane change is safe. Off by default: the paper's users accept any positive gap behind
     /// them (docs/paper-mapping.md, "Ego longitudinal behaviour and safety").
     pub users_wait_for_safe_gaps: bool,
     /// Response time `ρ` of the rear vehicle (s).
