@@ -43,8 +43,9 @@ pub struct SafetyConfig {
     /// only when both target-lane gaps stay at least the safe distance below at
     /// every step of the lane change started there (on the ego's lane-keeping
     /// motion), besides their style's own gap acceptance: users whose preferred
-    /// lane change is safe. Off by default: the paper's users accept any positive gap behind
-    /// them (docs/paper-mapping.md, "Ego longitudinal behaviour and safety").
+    /// lane change is safe. Off by default: the paper's users accept any positive
+    /// gap behind them (docs/paper-mapping.md, "Ego longitudinal behaviour and
+    /// safety").
     pub users_wait_for_safe_gaps: bool,
     /// Response time `ρ` of the rear vehicle (s).
     pub response_time_s: f64,

@@ -136,10 +136,12 @@ impl SimulatedUser {
         // and the safety layer refused the plans that copied it
         // (docs/paper-mapping.md, "Users who wait for safe gaps").
         let safety = &setup.safety;
+        // Saturating: a custom style's duration may exceed any window (the sanity
+        // check below refuses it), and its step count must not overflow here.
         let duration_steps = (duration_s / dt).ceil() as usize;
         let safe = |i: usize| {
             !safety.users_wait_for_safe_gaps
-                || (i..=(i + duration_steps).min(window))
+                || (i..=i.saturating_add(duration_steps).min(window))
                     .all(|j| target_gaps_safe(&situations[j], safety))
         };
         let start_step = (earliest..=window)
