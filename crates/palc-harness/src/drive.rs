@@ -155,13 +155,19 @@ pub fn execute(
                 ..plan.states[0]
             },
             (true, Some(previous)) => {
-                let leader = acc_leader(&scene);
-                let acc = (setup.acc).ego_acceleration(
-                    previous.v,
-                    setup.set_speed,
-                    leader,
-                    &setup.safety,
-                );
+                // Until its lane change starts, the user keeps its lane as the
+                // lane-keeping prediction does, gap seeking included: the motion
+                // on which it chose its start (and its safe gaps).
+                let acc = if i <= expectation.start_step {
+                    setup.lane_keeping_acceleration(&scene, i - 1)
+                } else {
+                    (setup.acc).ego_acceleration(
+                        previous.v,
+                        setup.set_speed,
+                        acc_leader(&scene),
+                        &setup.safety,
+                    )
+                };
                 let acceleration =
                     user.acceleration_after_takeover(expectation, i, previous.v, acc);
                 // Exact: a user who leaves its speed to the ACC returns its command.

@@ -173,6 +173,12 @@ pub struct Setup {
     /// a smaller one (not under the safety layer, where it requires the safe
     /// distance instead).
     pub standard_min_lead_gap_s: f64,
+    /// The standard ALC's style: its gap rule is what the ego's gap seeking waits for.
+    pub standard_alc: Style,
+    /// The first step of the search window at which the ego keeping its lane seeks
+    /// a gap (as close to the preceding vehicle as the standard ALC's start headway;
+    /// from then on it drops back while the gap beside it is not acceptable).
+    pub gap_seeking_from: Option<usize>,
     /// Lateral position of the target lane's centre (m).
     pub target_l: f64,
 }
@@ -232,7 +238,7 @@ impl Setup {
         let mut preceding = Vec::with_capacity(window + 1);
         let mut adjacent = Vec::with_capacity(window + 1);
         let mut lane_keeping = Vec::with_capacity(window + 1);
-        let mut seeking = false;
+        let mut gap_seeking_from = None;
         for step in 0..=window {
             situations.push(situation(&rollout));
             lane_keeping.push(
@@ -251,13 +257,17 @@ impl Setup {
             // The ego seeks a gap once it is as close to the preceding vehicle as
             // the standard ALC's start headway, so that every user (whose headway
             // is longer) has decided to change lanes; the search then goes on.
-            seeking |= situations[step].decides_at(config.standard_alc.time_headway_s);
+            if gap_seeking_from.is_none()
+                && situations[step].decides_at(config.standard_alc.time_headway_s)
+            {
+                gap_seeking_from = Some(step);
+            }
             if step < window {
                 lane_keeping_step(
                     &mut rollout,
                     config,
                     set_speed,
-                    seeking.then_some(&situations[step]),
+                    gap_seeking_from.map(|_| &situations[step]),
                 )?;
             }
         }
@@ -337,6 +347,8 @@ impl Setup {
             adjacent,
             standard_start_step,
             standard_min_lead_gap_s: config.standard_alc.min_lead_gap_s,
+            standard_alc: config.standard_alc,
+            gap_seeking_from,
             target_l: config.target_l,
         })
     }
@@ -352,6 +364,23 @@ impl Setup {
             self.target_l,
         );
         (expected.end_s() <= self.horizon as f64 * self.dt + 1e-9).then_some(expected)
+    }
+
+    /// The acceleration of the ego keeping its lane in `scene` at `step` of the
+    /// search window: the ACC and, from [`Setup::gap_seeking_from`] on, the gap
+    /// seeking of the lane-keeping prediction ([`Setup::lane_keeping`]), so that a
+    /// driver who keeps its lane moves as that prediction.
+    pub(crate) fn lane_keeping_acceleration(&self, scene: &Scene, step: usize) -> f64 {
+        let seen = situation(scene);
+        let seeking = self.gap_seeking_from.is_some_and(|from| step >= from);
+        lane_keeping_acceleration(
+            scene,
+            &self.acc,
+            &self.safety,
+            &self.standard_alc,
+            self.set_speed,
+            seeking.then_some(&seen),
+        )
     }
 
     /// The standard ALC's own lane change in this scenario.
@@ -432,9 +461,43 @@ pub(crate) fn target_gaps_safe(situation: &Situation, safety: &SafetyConfig) -> 
     lead_ok && lag_ok
 }
 
-/// One simulation step with the ego keeping its lane under its ACC; when seeking
-/// a gap (`seeking` holds what the ego sees now), it also drops back while the gap
-/// beside it is not acceptable.
+/// The acceleration of the ego keeping its lane under its ACC; when seeking a gap
+/// (`seeking` holds what the ego sees now), it also drops back while the gap
+/// beside it is neither acceptable to the standard ALC nor safe, below the target
+/// lane's speed, so that the next gap comes alongside.
+fn lane_keeping_acceleration(
+    scene: &Scene,
+    acc: &AccConfig,
+    safety: &SafetyConfig,
+    standard_alc: &Style,
+    set_speed: f64,
+    seeking: Option<&Situation>,
+) -> f64 {
+    let ego = scene.ego().map(|e| e.state).unwrap_or_default();
+    let leader = acc_leader(scene);
+    let acceleration = acc.ego_acceleration(ego.v, set_speed, leader, safety);
+    let unacceptable =
+        |seen: &&Situation| !(standard_alc.accepts(seen) && target_gaps_safe(seen, safety));
+    let Some(seen) = seeking.filter(unacceptable).filter(|_| acc.enabled) else {
+        return acceleration;
+    };
+    let flow = [seen.target_lead_speed, seen.target_lag_speed]
+        .into_iter()
+        .flatten()
+        .min_by(f64::total_cmp);
+    match flow {
+        Some(flow) => {
+            let target = (flow - acc.gap_seeking_speed_mps).max(0.0);
+            let drop_back =
+                (acc.cruise_gain * (target - ego.v)).max(-acc.comfort_deceleration_mps2);
+            acceleration.min(drop_back)
+        }
+        None => acceleration,
+    }
+}
+
+/// One simulation step with the ego keeping its lane
+/// ([`lane_keeping_acceleration`]).
 fn lane_keeping_step(
     scene: &mut Scene,
     config: &PlanningConfig,
@@ -442,26 +505,14 @@ fn lane_keeping_step(
     seeking: Option<&Situation>,
 ) -> Result<(), HarnessError> {
     let ego = scene.ego().map(|e| e.state).unwrap_or_default();
-    let leader = acc_leader(scene);
-    let mut acceleration = (config.acc).ego_acceleration(ego.v, set_speed, leader, &config.safety);
-    // Gap seeking: while the gap beside is neither acceptable to the standard ALC
-    // nor safe, drop back below the target lane's speed so that the next gap
-    // comes alongside.
-    let unacceptable = |seen: &&Situation| {
-        !(config.standard_alc.accepts(seen) && target_gaps_safe(seen, &config.safety))
-    };
-    if let Some(seen) = seeking.filter(unacceptable).filter(|_| config.acc.enabled) {
-        let flow = [seen.target_lead_speed, seen.target_lag_speed]
-            .into_iter()
-            .flatten()
-            .min_by(f64::total_cmp);
-        if let Some(flow) = flow {
-            let target = (flow - config.acc.gap_seeking_speed_mps).max(0.0);
-            let drop_back = (config.acc.cruise_gain * (target - ego.v))
-                .max(-config.acc.comfort_deceleration_mps2);
-            acceleration = acceleration.min(drop_back);
-        }
-    }
+    let acceleration = lane_keeping_acceleration(
+        scene,
+        &config.acc,
+        &config.safety,
+        &config.standard_alc,
+        set_speed,
+        seeking,
+    );
     let moved = ballistic_step(ego.v, acceleration, config.dt);
     let next = EgoState {
         s: ego.s + moved.distance,

@@ -345,7 +345,43 @@ fn users_who_wait_for_safe_gaps_start_at_the_safe_distance_and_never_earlier() {
 /// the safe distance and `palc` learns it in one takeover.
 #[test]
 fn a_user_who_waits_for_safe_gaps_keeps_them_through_its_lane_change() {
-    use palc_harness::{CellChoice, LearnConfig, Method, NoObserver, StylePreset, UserConfig, run};
+    let cautious = palc_harness::UserConfig::preset(palc_harness::StylePreset::Cautious);
+    users_own_lane_changes_keep_the_safe_distance("collector-high", 35.0, cautious);
+}
+
+/// Under the safe set-up, a user who takes over while it waits for a gap keeps
+/// seeking it as the lane-keeping prediction on which it chose its start does
+/// (dropping back below the target lane's speed). Driven at the ACC's speed
+/// alone, it came alongside the target lane's leader instead: 2.0 m behind it
+/// (RSS distance 20.4 m) in each of `paper`'s 30 lane changes here
+/// (collector-slow / 35 m / seed 1, cautious), 990 such lane changes on the grid.
+#[test]
+fn a_user_who_takes_over_while_waiting_for_a_gap_drops_back_as_predicted() {
+    let cautious = palc_harness::UserConfig::preset(palc_harness::StylePreset::Cautious);
+    users_own_lane_changes_keep_the_safe_distance("collector-slow", 35.0, cautious);
+}
+
+/// A speed-matching user checks the gaps on its own speed from its start on: it
+/// slowed towards the target lane's speed and fell 7.1 m ahead of the lag vehicle
+/// (RSS distance 8.1 m) when it had checked them at the lane keeping's speed
+/// (collector-high / 50 m / seed 1, aggressive).
+#[test]
+fn a_speed_matching_user_checks_the_gaps_on_its_own_speed() {
+    let text = "[user]\nstyle = \"aggressive\"\n\
+                family = { speed = { rule = \"accelerating\", max_acceleration_mps2 = 1.5 } }\n";
+    let user = palc_harness::UserConfig::from_toml_str(text, 0.3).expect("the user parses");
+    users_own_lane_changes_keep_the_safe_distance("collector-high", 50.0, user);
+}
+
+/// `paper` (taken over in every lane change, so that the user drives each one
+/// itself) keeps the RSS distance in the user's driving as in the system's, and
+/// `palc` learns the user in one takeover with no refused plan.
+fn users_own_lane_changes_keep_the_safe_distance(
+    speed_case: &str,
+    headway_m: f64,
+    user: palc_harness::UserConfig,
+) {
+    use palc_harness::{CellChoice, LearnConfig, Method, NoObserver, run};
 
     let text = include_str!("../../../configs/learn-safe.toml");
     let config = |method| {
@@ -353,14 +389,13 @@ fn a_user_who_waits_for_safe_gaps_keeps_them_through_its_lane_change() {
             .expect("the safe config parses")
             .with_method(method)
             .with_cell(CellChoice {
-                speed_case: "collector-high".into(),
-                headway_m: 35.0,
+                speed_case: speed_case.into(),
+                headway_m,
                 seed: 1,
             })
-            .with_user(UserConfig::preset(StylePreset::Cautious))
+            .with_user(user.clone())
     };
     let paper = run(&config(Method::Paper), None, &mut NoObserver).expect("the scene runs");
-    // `paper` takes over in every lane change: the user drives each one itself.
     assert_eq!(paper.summary.takeovers, paper.records.len());
     for record in &paper.records {
         assert_eq!(

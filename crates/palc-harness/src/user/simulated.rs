@@ -13,6 +13,7 @@ use crate::user::expectation::{
 };
 use crate::user::family::{Family, SpeedRule};
 use crate::user::profile::TABLE_END_TOLERANCE_M;
+use crate::user::situation::Situation;
 use crate::user::spread::Spread;
 use crate::user::style::Style;
 
@@ -138,11 +139,28 @@ impl SimulatedUser {
         let safety = &setup.safety;
         // Saturating: a custom style's duration may exceed any window (the sanity
         // check below refuses it), and its step count must not overflow here.
+        // A user with a speed of its own (speed matching) checks the gaps on its
+        // own motion from the start on, not on the lane keeping's: a speed-matching
+        // user slowing towards the target lane's speed fell 7.1 m ahead of the lag
+        // vehicle against an RSS distance of 8.1 m (collector-high / 50 m / seed 1).
         let duration_steps = (duration_s / dt).ceil() as usize;
         let safe = |i: usize| {
-            !safety.users_wait_for_safe_gaps
-                || (i..=i.saturating_add(duration_steps).min(window))
-                    .all(|j| target_gaps_safe(&situations[j], safety))
+            if !safety.users_wait_for_safe_gaps {
+                return true;
+            }
+            let target_speed = target_speed_at(&situations[i], setup.set_speed);
+            let mut own = setup.lane_keeping[i];
+            (i..=i.saturating_add(duration_steps).min(window)).all(|j| {
+                let keeping = setup.lane_keeping[j];
+                if j > i {
+                    own = match speed_rule_step(family.speed, own[1], target_speed, dt) {
+                        Some(v) => [own[0] + 0.5 * (own[1] + v) * dt, v],
+                        None => keeping,
+                    };
+                }
+                let seen = situations[j].seen_from(own[0] - keeping[0], own[1]);
+                target_gaps_safe(&situations[j], safety) && target_gaps_safe(&seen, safety)
+            })
         };
         let start_step = (earliest..=window)
             .find(|&i| accepting.accepts(&situations[i]) && safe(i))
@@ -166,11 +184,7 @@ impl SimulatedUser {
             to_l: setup.target_l,
             profile: family.profile.clone(),
         };
-        let seen = &situations[start_step];
-        let target_speed = seen
-            .target_lead_speed
-            .or(seen.target_lag_speed)
-            .unwrap_or(setup.set_speed);
+        let target_speed = target_speed_at(&situations[start_step], setup.set_speed);
         let states = expected_states(setup, &lane_change, start_step, family.speed, target_speed);
         let expectation = Expectation {
             lane_change,
@@ -203,22 +217,14 @@ fn expected_states(
     let mut states: Vec<State> = Vec::with_capacity(n);
     for i in 0..n {
         let [keeping_s, keeping_v] = setup.lane_keeping[i.min(setup.lane_keeping.len() - 1)];
-        let (s, v) = match (speed, states.last()) {
-            (
-                SpeedRule::Accelerating {
-                    max_acceleration_mps2,
-                },
-                Some(previous),
-            ) if i > start_step => {
-                // The speed gap times 1/s, bounded: as the user drives after a
-                // takeover (`User::acceleration_after_takeover`).
-                let a = (target_speed - previous.v)
-                    .clamp(-max_acceleration_mps2, max_acceleration_mps2);
-                let v = previous.v + a * dt;
-                (previous.s + 0.5 * (previous.v + v) * dt, v)
-            }
-            _ => (keeping_s, keeping_v),
-        };
+        let own = states
+            .last()
+            .filter(|_| i > start_step)
+            .and_then(|previous| {
+                let v = speed_rule_step(speed, previous.v, target_speed, dt)?;
+                Some((previous.s + 0.5 * (previous.v + v) * dt, v))
+            });
+        let (s, v) = own.unwrap_or((keeping_s, keeping_v));
         states.push(State {
             s,
             v,
@@ -231,6 +237,30 @@ fn expected_states(
         states[i].phi = (states[i + 1].l - states[i].l) / run;
     }
     states
+}
+
+/// The speed a speed-matching user heads for once it starts in `seen`: the target
+/// lane's leader's, else its follower's, else the ego's set speed.
+fn target_speed_at(seen: &Situation, set_speed: f64) -> f64 {
+    seen.target_lead_speed
+        .or(seen.target_lag_speed)
+        .unwrap_or(set_speed)
+}
+
+/// The user's speed one step after `v` under its own speed rule, or `None` when it
+/// leaves its speed to the ego's lane keeping. Accelerating: the speed gap times
+/// 1/s, bounded, as the user drives after a takeover
+/// (`User::acceleration_after_takeover`).
+fn speed_rule_step(speed: SpeedRule, v: f64, target_speed: f64, dt: f64) -> Option<f64> {
+    match speed {
+        SpeedRule::Accelerating {
+            max_acceleration_mps2,
+        } => {
+            let a = (target_speed - v).clamp(-max_acceleration_mps2, max_acceleration_mps2);
+            Some(v + a * dt)
+        }
+        SpeedRule::Constant => None,
+    }
 }
 
 /// The sanity checks of an expected lane change: it ends inside the search
