@@ -329,7 +329,7 @@ fn assumed_lead_gap_s(setup: &Setup, smallest_accepted: f64) -> f64 {
     if setup.safety.enforce {
         0.0
     } else {
-        setup.standard_min_lead_gap_s.min(smallest_accepted)
+        setup.standard_alc.min_lead_gap_s.min(smallest_accepted)
     }
 }
 

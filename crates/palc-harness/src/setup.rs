@@ -167,13 +167,10 @@ pub struct Setup {
     pub adjacent: Vec<[f64; 2]>,
     /// Start step of the standard ALC.
     pub standard_start_step: usize,
-    /// The smallest lead gap on the target lane the standard ALC accepts, as a time
-    /// gap at the ego's speed (s; `planning.standard_alc.min_lead_gap_s`): what the
-    /// relative-onset prediction assumes a user needs until the user has accepted
-    /// a smaller one (not under the safety layer, where it requires the safe
-    /// distance instead).
-    pub standard_min_lead_gap_s: f64,
-    /// The standard ALC's style: its gap rule is what the ego's gap seeking waits for.
+    /// The standard ALC's style (`planning.standard_alc`): its gap rule is what the
+    /// ego's gap seeking waits for, and its lead gap what the relative-onset
+    /// prediction assumes a user needs until the user has accepted a smaller one
+    /// (not under the safety layer, where it requires the safe distance instead).
     pub standard_alc: Style,
     /// The first step of the search window at which the ego keeping its lane seeks
     /// a gap (as close to the preceding vehicle as the standard ALC's start headway;
@@ -346,7 +343,6 @@ impl Setup {
             preceding,
             adjacent,
             standard_start_step,
-            standard_min_lead_gap_s: config.standard_alc.min_lead_gap_s,
             standard_alc: config.standard_alc,
             gap_seeking_from,
             target_l: config.target_l,
