@@ -367,15 +367,15 @@ impl Setup {
     /// seeking of the lane-keeping prediction ([`Setup::lane_keeping`]), so that a
     /// driver who keeps its lane moves as that prediction.
     pub(crate) fn lane_keeping_acceleration(&self, scene: &Scene, step: usize) -> f64 {
-        let seen = situation(scene);
         let seeking = self.gap_seeking_from.is_some_and(|from| step >= from);
+        let seen = seeking.then(|| situation(scene));
         lane_keeping_acceleration(
             scene,
             &self.acc,
             &self.safety,
             &self.standard_alc,
             self.set_speed,
-            seeking.then_some(&seen),
+            seen.as_ref(),
         )
     }
 

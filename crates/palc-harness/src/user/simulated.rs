@@ -137,12 +137,14 @@ impl SimulatedUser {
         // and the safety layer refused the plans that copied it
         // (docs/paper-mapping.md, "Users who wait for safe gaps").
         let safety = &setup.safety;
+        // A user with a speed of its own (speed matching) checks the gaps on its
+        // own motion from the start on as well: checked on the lane keeping's alone,
+        // a speed-matching user slowing towards the target lane's speed fell 7.1 m
+        // ahead of the lag vehicle against an RSS distance of 8.1 m (collector-high
+        // / 50 m / seed 1). The lane keeping's stays checked too: the plans that copy
+        // the start drive at its speed, and the safety layer refused them otherwise.
         // Saturating: a custom style's duration may exceed any window (the sanity
         // check below refuses it), and its step count must not overflow here.
-        // A user with a speed of its own (speed matching) checks the gaps on its
-        // own motion from the start on, not on the lane keeping's: a speed-matching
-        // user slowing towards the target lane's speed fell 7.1 m ahead of the lag
-        // vehicle against an RSS distance of 8.1 m (collector-high / 50 m / seed 1).
         let duration_steps = (duration_s / dt).ceil() as usize;
         let safe = |i: usize| {
             if !safety.users_wait_for_safe_gaps {
