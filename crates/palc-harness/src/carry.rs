@@ -22,9 +22,9 @@ use crate::setup::Setup;
 /// [`Representation::RelativeOnset`] and a user's start observed before, they are
 /// also shifted so that the learned start falls where this scene predicts the
 /// relative state the user started in ([`predicted_start_s`]), held no later than
-/// the standard ALC's start (no user starts after it: the scenario's premise); the
-/// last lesson's path is shifted alike and returned for [`rehearse`]. Without an
-/// observed start, or when none is predicted here, the weights keep their time base.
+/// [`latest_planned_start_s`]; the last lesson's path is shifted alike and returned
+/// for [`rehearse`]. Without an observed start, or when none is predicted here, the
+/// weights keep their time base.
 pub(crate) fn starting_experience(
     config: &LearnConfig,
     setup: &Setup,
@@ -49,7 +49,7 @@ pub(crate) fn starting_experience(
     carried.metadata.scenario = config.label();
     let anchored = match (options.representation, previous.anchor_s) {
         (Representation::RelativeOnset, Some(anchor)) => {
-            let latest = setup.standard_start_step as f64 * dt;
+            let latest = latest_planned_start_s(config, setup, previous, anchor);
             predicted_start_s(setup, &previous.onsets).map(|start| (anchor, start.min(latest)))
         }
         _ => None,
@@ -68,6 +68,45 @@ pub(crate) fn starting_experience(
         .map(|path| shifted_path(path, from_dt, k, dt, shift));
     carried.demonstration.clone_from(&path);
     Ok((carried, path))
+}
+
+/// The latest start (s) a carried lane change is anchored at: the one whose lane
+/// change, as long as the carried one (its demonstration from `anchor_s` until it
+/// settles within 1 % of its end; the standard ALC's duration without one), ends
+/// within the planning horizon. Never before the standard ALC's start.
+///
+/// Users whose family waits for a follower's gap start after the standard ALC (the
+/// premise that no user does holds for the paper's three styles only); holding
+/// every prediction at the standard ALC's start put theirs up to a second early.
+/// The horizon may have been extended to cover the simulated user's own lane
+/// change plus the margin; a prediction held at its end is then still later than
+/// the user's start by the margin, so the bound never turns a late prediction
+/// into a right one.
+fn latest_planned_start_s(
+    config: &LearnConfig,
+    setup: &Setup,
+    previous: &Experience,
+    anchor_s: f64,
+) -> f64 {
+    let standard_start = setup.standard_start_step as f64 * setup.dt;
+    let duration = (previous.demonstration.as_deref())
+        .and_then(|path| settled_s(path, previous.metadata.dt))
+        .map_or(config.planning.standard_alc.lane_change_duration_s, |end| {
+            (end - anchor_s).max(0.0)
+        });
+    (setup.horizon as f64 * setup.dt - duration).max(standard_start)
+}
+
+/// The first time (s) from which `path` (step `dt`) stays within 1 % of its last
+/// value's magnitude; `None` for an empty path or a last value of 0.
+fn settled_s(path: &[f64], dt: f64) -> Option<f64> {
+    let last = *path.last()?;
+    let tolerance = 0.01 * last.abs();
+    if tolerance == 0.0 {
+        return None;
+    }
+    let unsettled = path.iter().rposition(|l| (l - last).abs() > tolerance);
+    Some(unsettled.map_or(0.0, |i| (i + 1) as f64 * dt))
 }
 
 /// `path` (step `from_dt`) at steps `0..=horizon` of `to_dt`, moved `shift_s`
@@ -147,5 +186,15 @@ mod tests {
             assert!((got - want).abs() < 1e-12, "{later:?}");
         }
         assert_eq!(shifted_path(&path, 0.1, 3, 0.1, 0.0), path.to_vec());
+    }
+
+    #[test]
+    fn a_path_settles_where_it_stays_within_one_percent_of_its_end() {
+        let path = [0.0, 0.0, 1.0, 3.0, 3.47, 3.5, 3.5];
+        // 3.47 is within 0.035 of 3.5; 3.0 is not.
+        let settled = settled_s(&path, 0.1).expect("a lane change");
+        assert!((settled - 0.4).abs() < 1e-12, "{settled}");
+        assert_eq!(settled_s(&[0.0, 0.0], 0.1), None);
+        assert_eq!(settled_s(&[], 0.1), None);
     }
 }

@@ -25,10 +25,13 @@
 //! decision threshold) bounds the lead gap the user needs from below, the largest
 //! rejected gap of gap-acceptance models; and when every onset was held back by
 //! a follower alongside, the headway just before that follower arrived bounds the
-//! decision from above (the user had not started there). A lead gap the user
-//! accepted bounds the one it needs from above; until it has accepted one smaller
-//! than the standard ALC's requirement, that requirement is assumed (the system's
-//! own, not fitted to any user).
+//! decision from above (the user had not started there). A start at a headway
+//! below the standard ALC's decision headway, with the follower's gap opening into
+//! it, is read as a wait for that gap (every user decides before the standard ALC
+//! does: the paper's premise). A lead gap the user accepted bounds the one it
+//! needs from above; until it has accepted one smaller than the standard ALC's
+//! requirement, that requirement is assumed (the system's own, not fitted to any
+//! user).
 
 use palc_aggregator::Onset;
 
@@ -272,11 +275,42 @@ pub(crate) fn onset_at(setup: &Setup, start_s: f64, before: &[Onset]) -> Option<
     if onset.lag_time_gap_s.is_some() {
         onset.time_headway_ceiling_s = last_open_step_before_alongside(setup, step)
             .map(|i| setup.situations[i].time_headway_s);
+    } else if onset.lead_time_gap_s.is_none() && waited_for_the_follower(setup, step) {
+        // Every user decides before the standard ALC would (the paper's premise,
+        // `Setup::check_conservative`): the decision was taken at a headway of at
+        // least the standard ALC's, and the follower's gap held the user back.
+        onset.lag_time_gap_s = revealed(setup, step, lag_time_gap);
+        onset.time_headway_s = onset.time_headway_s.max(setup.standard_alc.time_headway_s);
     }
     let mut onsets = before.to_vec();
     onsets.push(onset.clone());
     onset.rejected_lead_time_gap_s = rejected_lead(setup, step, decision(&onsets));
     Some(onset)
+}
+
+/// Whether a start at `step` that no vehicle alongside held back waited for the
+/// follower's gap: the time headway there is below the standard ALC's decision
+/// headway, which a user's own decision never is (the paper's premise: the
+/// standard ALC is later than every user), so something held the user back; the
+/// follower's gap was opening into the start, and the leader's was already at
+/// least the one the user is assumed to need at the step before (so it was not
+/// what the user waited for).
+fn waited_for_the_follower(setup: &Setup, step: usize) -> bool {
+    let Some(before) = step.checked_sub(1).map(|i| &setup.situations[i]) else {
+        return false;
+    };
+    let start = &setup.situations[step];
+    let opening = match (lag_time_gap(before), lag_time_gap(start)) {
+        (Some(before), Some(at)) => before > 0.0 && at > before,
+        _ => false,
+    };
+    let accepted = lead_time_gap(start).unwrap_or(f64::INFINITY);
+    let lead = assumed_lead_gap_s(setup, accepted);
+    let leader_open = lead_time_gap(before).is_none_or(|g| g >= lead);
+    start.time_headway_s > 0.0
+        && start.time_headway_s < setup.standard_alc.time_headway_s
+        && opening
+        && leader_open
 }
 
 /// The last step before the target lane's follower came alongside the ego and

@@ -343,3 +343,43 @@ fn a_start_after_the_follower_has_left_is_a_decision_not_a_wait() {
     let target = config("collector-high", 50.0, style);
     assert_start_predicted_to_the_step(&target, &experience, style);
 }
+
+#[test]
+fn a_start_after_the_standard_alc_waited_for_the_follower() {
+    // A user who needs 0.5 s behind (the perceived-safety family) starts in
+    // collector-high / 50 m / seed 2 at a time headway of 0.23 s, after the
+    // standard ALC (1.0 s), whatever its style: the follower's gap held it back.
+    // Read as a decision, that headway started it 0.9 s early in arterial-high /
+    // 50 m, and the prediction was held at the standard ALC's start besides. Read
+    // as a wait for the follower (its time gap learned, the decision no later than
+    // the standard ALC's), the carried start is the user's to the step, and the
+    // first lane change there needs no takeover.
+    let config = |speed_case: &str| {
+        let user = UserConfig::from_toml_str(
+            "[user]\nstyle = \"neutral\"\nfamily = { min_lead_gap_s = 0.8, min_lag_gap_s = 0.5 }\n",
+            0.3,
+        )
+        .expect("the user parses");
+        LearnConfig::from_toml_str(include_str!("../../../configs/learn.toml"))
+            .expect("the default config parses")
+            .with_cell(CellChoice {
+                speed_case: speed_case.into(),
+                headway_m: 50.0,
+                seed: 2,
+            })
+            .with_user(user)
+    };
+    let experience = learned_in(&config("collector-high"));
+    let onset = experience.onsets.last().expect("an onset");
+    let lag = onset.lag_time_gap_s.expect("the follower held it back");
+    assert!((lag - 0.5).abs() < 0.02, "follower gap {lag} s");
+    assert!(
+        onset.time_headway_s >= 1.0,
+        "decided at {} s",
+        onset.time_headway_s
+    );
+    let target = config("arterial-high");
+    assert_start_predicted_to_the_step(&target, &experience, StylePreset::Neutral);
+    let carried = run(&target, Some(&experience), &mut NoObserver).expect("the run completes");
+    assert_eq!(carried.summary.takeovers, 0);
+}
