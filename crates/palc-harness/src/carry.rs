@@ -89,11 +89,13 @@ fn latest_planned_start_s(
     anchor_s: f64,
 ) -> f64 {
     let standard_start = setup.standard_start_step as f64 * setup.dt;
+    // A demonstration that settles before its own start (none learned yet) says
+    // nothing: the standard ALC's duration, the longest, is assumed instead.
     let duration = (previous.demonstration.as_deref())
         .and_then(|path| settled_s(path, previous.metadata.dt))
-        .map_or(config.planning.standard_alc.lane_change_duration_s, |end| {
-            (end - anchor_s).max(0.0)
-        });
+        .map(|end| end - anchor_s)
+        .filter(|&duration| duration > 0.0)
+        .unwrap_or(config.planning.standard_alc.lane_change_duration_s);
     (setup.horizon as f64 * setup.dt - duration).max(standard_start)
 }
 
