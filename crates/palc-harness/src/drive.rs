@@ -129,6 +129,9 @@ pub fn execute(
         p.map_or([1e4, 0.0], |v| [v.state.s - setup.origin_s, v.state.l])
     };
     let mut user_speed_differs = false;
+    let seeking_until = (expectation.lane_change.end_s() / dt - 1e-9)
+        .ceil()
+        .max(0.0) as usize;
     // Where the system had driven the ego when the user took over: the plan's
     // state there, unless the longitudinal guard held the ego back.
     let mut at_takeover = plan.states[0];
@@ -155,10 +158,10 @@ pub fn execute(
                 ..plan.states[0]
             },
             (true, Some(previous)) => {
-                // Until its lane change starts, the user keeps its lane as the
-                // lane-keeping prediction does, gap seeking included: the motion
-                // on which it chose its start (and its safe gaps).
-                let acc = if i <= expectation.start_step {
+                // Until its lane change ends, the user moves as the lane-keeping
+                // prediction does, gap seeking included: the motion on which it
+                // chose its start and checked its gaps.
+                let acc = if i <= seeking_until {
                     setup.lane_keeping_acceleration(&scene, i - 1)
                 } else {
                     (setup.acc).ego_acceleration(
