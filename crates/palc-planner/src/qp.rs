@@ -88,21 +88,52 @@ pub(crate) struct Dynamics {
 /// One inequality row `coef · ux[core] + slack_coef · σ[slack] <= h`.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Inequality {
-    /// `(stage, local index in [X; U])` of the stage variable, if any.
-    pub core: Option<(usize, usize)>,
+    /// `(stage, local index in [X; U])` of the stage variable, if any, packed
+    /// (16 bytes with the slack's index instead of 40: the interior point reads every
+    /// row several times per iteration).
+    core: Option<(u32, u32)>,
     pub coef: f64,
     /// Index of the slack variable, if any.
-    pub slack: Option<usize>,
+    slack: Option<u32>,
     pub slack_coef: f64,
     pub h: f64,
 }
 
 impl Inequality {
+    /// The row `coef · ux[core] + slack_coef · σ[slack] <= h`.
+    pub fn new(
+        core: Option<(usize, usize)>,
+        coef: f64,
+        slack: Option<usize>,
+        slack_coef: f64,
+        h: f64,
+    ) -> Self {
+        Self {
+            core: core.map(|(i, l)| (i as u32, l as u32)),
+            coef,
+            slack: slack.map(|k| k as u32),
+            slack_coef,
+            h,
+        }
+    }
+
+    /// `(stage, local index in [X; U])` of the stage variable, if any.
+    #[inline(always)]
+    pub fn core(&self) -> Option<(usize, usize)> {
+        self.core.map(|(i, l)| (i as usize, l as usize))
+    }
+
+    /// Index of the slack variable, if any.
+    #[inline(always)]
+    pub fn slack(&self) -> Option<usize> {
+        self.slack.map(|k| k as usize)
+    }
+
     /// `(G x)_j` of this row for the stage variables `ux` and the slacks `σ`.
     #[inline(always)]
     pub fn times(&self, ux: &[Vector6<f64>], sigma: &[f64]) -> f64 {
-        self.core.map_or(0.0, |(i, l)| self.coef * ux[i][l])
-            + self.slack.map_or(0.0, |k| self.slack_coef * sigma[k])
+        self.core().map_or(0.0, |(i, l)| self.coef * ux[i][l])
+            + self.slack().map_or(0.0, |k| self.slack_coef * sigma[k])
     }
 }
 
@@ -269,13 +300,8 @@ impl StageQp {
         // Inequality rows: steering (Eq. 23), lateral (Eq. 22), slacks.
         for i in 0..k {
             for (coef, h) in [(1.0, config.steering_max), (-1.0, -config.steering_min)] {
-                self.inequalities.push(Inequality {
-                    core: Some((i, DELTA)),
-                    coef,
-                    slack: None,
-                    slack_coef: 0.0,
-                    h,
-                });
+                self.inequalities
+                    .push(Inequality::new(Some((i, DELTA)), coef, None, 0.0, h));
                 self.row_tags.push(RowTag::Steering(i));
             }
         }
@@ -292,24 +318,14 @@ impl StageQp {
             };
             for (value, sign) in [(bound.max, 1.0), (bound.min, -1.0)] {
                 if let Some(value) = value {
-                    let row = Inequality {
-                        core: Some((step, L)),
-                        coef: sign,
-                        slack,
-                        slack_coef: if slack.is_some() { -1.0 } else { 0.0 },
-                        h: sign * value,
-                    };
+                    let slack_coef = if slack.is_some() { -1.0 } else { 0.0 };
+                    let row =
+                        Inequality::new(Some((step, L)), sign, slack, slack_coef, sign * value);
                     add(self, row, RowTag::Lateral(step));
                 }
             }
             if slack.is_some() {
-                let row = Inequality {
-                    core: None,
-                    coef: 0.0,
-                    slack,
-                    slack_coef: -1.0,
-                    h: 0.0,
-                };
+                let row = Inequality::new(None, 0.0, slack, -1.0, 0.0);
                 add(self, row, RowTag::Slack);
                 self.slack_core.push(Some((step, L)));
                 self.slack_rows.push(rows);

@@ -115,10 +115,10 @@ impl SparseQp {
         // Inequality rows: steering (Eq. 23), lateral (Eq. 22), slacks.
         for (j, row) in qp.inequalities.iter().enumerate() {
             let r = qp.m_eq + j;
-            if let Some((i, l)) = row.core {
+            if let Some((i, l)) = row.core() {
                 self.a(r, state_index(i) + l, row.coef);
             }
-            if let Some(slack) = row.slack {
+            if let Some(slack) = row.slack() {
                 self.a(r, qp.slack_column(slack), row.slack_coef);
             }
             self.b.push(row.h);

@@ -69,12 +69,6 @@ impl StepDynamics {
         out
     }
 
-    /// `X B`.
-    #[inline(always)]
-    pub fn right_b(&self, x: &Matrix4<f64>) -> Matrix4x2<f64> {
-        Matrix4x2::from_columns(&[x.column(1) * self.bv, x.column(3) * self.bphi])
-    }
-
     /// `Aᵀ X`.
     #[inline(always)]
     pub fn a_tr_left<const C: usize>(&self, x: &SMatrix<f64, 4, C>) -> SMatrix<f64, 4, C> {
@@ -118,7 +112,6 @@ mod tests {
             prop_assert!(close(s.a_tr_mul(&ym).as_slice(), a.tr_mul(&ym).as_slice()));
             prop_assert!(close(s.b_tr_mul(&ym).as_slice(), b.tr_mul(&ym).as_slice()));
             prop_assert!(close(s.right_a(&xm).as_slice(), (xm * a).as_slice()));
-            prop_assert!(close(s.right_b(&xm).as_slice(), (xm * b).as_slice()));
             prop_assert!(close(s.a_tr_left(&xm).as_slice(), a.tr_mul(&xm).as_slice()));
             prop_assert!(close(s.b_tr_left(&xm).as_slice(), b.tr_mul(&xm).as_slice()));
         }

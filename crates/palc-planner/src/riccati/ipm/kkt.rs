@@ -58,10 +58,10 @@ pub(crate) struct Kkt {
 /// `out += Gᵀ v`, split into stage variables and slacks.
 fn add_g_transpose(qp: &StageQp, v: &[f64], out: &mut [Vector6<f64>], out_sigma: &mut [f64]) {
     for (row, &v) in qp.inequalities.iter().zip(v) {
-        if let Some((i, l)) = row.core {
+        if let Some((i, l)) = row.core() {
             out[i][l] += row.coef * v;
         }
-        if let Some(j) = row.slack {
+        if let Some(j) = row.slack() {
             out_sigma[j] += row.slack_coef * v;
         }
     }
@@ -136,7 +136,7 @@ impl Kkt {
     pub fn factor(&mut self, qp: &StageQp) -> Result<(), FactorError> {
         self.newton_diag.fill(Vector6::zeros());
         for (row, &w) in qp.inequalities.iter().zip(&self.w) {
-            if let (Some((i, l)), None) = (row.core, row.slack) {
+            if let (Some((i, l)), None) = (row.core(), row.slack()) {
                 self.newton_diag[i][l] += w * row.coef * row.coef;
             }
         }
@@ -145,12 +145,12 @@ impl Kkt {
             let (mut h_ss, mut h_sv, mut pairs) = (0.0, 0.0, 0.0);
             for (n, p) in rows.clone().enumerate() {
                 let (rp, wp) = (&qp.inequalities[p], self.w[p]);
-                let cp = if rp.core.is_some() { rp.coef } else { 0.0 };
+                let cp = if rp.core().is_some() { rp.coef } else { 0.0 };
                 h_ss += wp * rp.slack_coef * rp.slack_coef;
                 h_sv += wp * cp * rp.slack_coef;
                 for q in rows.clone().skip(n + 1) {
                     let (rq, wq) = (&qp.inequalities[q], self.w[q]);
-                    let cq = if rq.core.is_some() { rq.coef } else { 0.0 };
+                    let cq = if rq.core().is_some() { rq.coef } else { 0.0 };
                     let minor = cp * rq.slack_coef - cq * rp.slack_coef;
                     pairs += wp * wq * minor * minor;
                 }

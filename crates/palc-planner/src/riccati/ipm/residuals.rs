@@ -82,10 +82,10 @@ impl Residuals {
             let (dual, dual_sigma) = (&mut self.dual, &mut self.dual_sigma);
             for (j, row) in qp.inequalities.iter().enumerate() {
                 let (l, s) = (lambda[j], s[j]);
-                if let Some((i, c)) = row.core {
+                if let Some((i, c)) = row.core() {
                     dual[i][c] += row.coef * l;
                 }
-                if let Some(n) = row.slack {
+                if let Some(n) = row.slack() {
                     dual_sigma[n] += row.slack_coef * l;
                 }
                 let gx = row.times(&v.ux, &v.sigma);

@@ -36,7 +36,7 @@ fn stage_and_kind(
     row: &Inequality,
     slack_core: &[Option<(usize, usize)>],
 ) -> Option<(usize, usize)> {
-    let (core, kind, coef) = match (row.core, row.slack) {
+    let (core, kind, coef) = match (row.core(), row.slack()) {
         (Some(core), None) => (core, 0, row.coef),
         (Some(core), Some(_)) => (core, 1, row.coef),
         (None, Some(j)) => (slack_core.get(j).copied().flatten()?, 2, row.slack_coef),
@@ -137,7 +137,7 @@ impl Ipm {
         // controls of stage K - 1 and on the rows of X_K that no terminal row fixes.
         let mut gl = [Vector6::zeros(); 2];
         for (row, &l) in qp.inequalities.iter().zip(&w.lambda) {
-            if let Some((i, c)) = row.core {
+            if let Some((i, c)) = row.core() {
                 if i + 1 >= k {
                     gl[i + 1 - k][c] += row.coef * l;
                 }
