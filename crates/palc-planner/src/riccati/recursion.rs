@@ -24,13 +24,18 @@
 //! Every block has a fixed size (4 x 4, 4 x 2, 2 x 2); all buffers are sized by
 //! [`Riccati::resize`], so [`Riccati::factor`] and [`Riccati::solve`] never allocate.
 
-use nalgebra::{Matrix2, Matrix2x4, Matrix4, Matrix6, Vector2, Vector4, Vector6};
+use nalgebra::{Matrix2, Matrix2x4, Matrix4, Matrix6, SMatrix, SVector, Vector2, Vector4, Vector6};
 
 use super::params::{
     CONTROL_REGULARIZATION, CONTROL_REGULARIZATION_RELATIVE, TERMINAL_FLOOR, TERMINAL_REFINEMENTS,
     TERMINAL_REGULARIZATION, TERMINAL_TOLERANCE,
 };
 use crate::qp::{Dynamics, NX};
+
+/// The terminal rows of every lane change: `v`, `l` and `φ` (Eq. 21; `s` only when
+/// the problem fixes it): `Γ`'s products are specialized to three columns, a fifth
+/// of the backward pass's arithmetic saved over four.
+const TERMINAL_COLUMNS_USUAL: usize = 3;
 
 /// Why a factorization failed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -122,17 +127,30 @@ impl Riccati {
         terminal: &Matrix4<f64>,
         m: usize,
     ) -> Result<(), FactorError> {
-        match self.factor_with(h, d, dynamics, terminal, m, false) {
-            Err(FactorError::ControlBlock(_)) => {
-                self.factor_with(h, d, dynamics, terminal, m, true)
+        let pass = |riccati: &mut Self, semidefinite_p| {
+            if m <= TERMINAL_COLUMNS_USUAL {
+                riccati.factor_with::<TERMINAL_COLUMNS_USUAL>(
+                    h,
+                    d,
+                    dynamics,
+                    terminal,
+                    m,
+                    semidefinite_p,
+                )
+            } else {
+                riccati.factor_with::<NX>(h, d, dynamics, terminal, m, semidefinite_p)
             }
+        };
+        match pass(self, false) {
+            Err(FactorError::ControlBlock(_)) => pass(self, true),
             result => result,
         }
     }
 
     /// The backward pass; `semidefinite_p` projects every `P_i` onto the semidefinite
-    /// cone.
-    fn factor_with(
+    /// cone. `Γ`, `BᵀΓ` and `W` are computed on their first `M >= m` columns, the
+    /// others being zero (`Γ_K = Eᵀ`).
+    fn factor_with<const M: usize>(
         &mut self,
         h: &[Matrix6<f64>],
         d: &[Vector6<f64>],
@@ -149,7 +167,7 @@ impl Riccati {
             self.p[k][(j, j)] += d[k][j];
         }
         self.gamma[k] = terminal.transpose();
-        let mut w = Matrix4::<f64>::zeros();
+        let mut w = SMatrix::<f64, M, M>::zeros();
         for i in (0..k).rev() {
             let diag = &d[i];
             let d = &dynamics[i].sparse;
@@ -197,20 +215,26 @@ impl Riccati {
                 p = semidefinite(p);
             }
             // Γ_i = (A + BK)ᵀ Γ = AᵀΓ + Kᵀ (BᵀΓ).
-            let bt_gamma = d.b_tr_left(&self.gamma[i + 1]);
-            let at_gamma = d.a_tr_left(&self.gamma[i + 1]);
-            self.gamma[i] =
-                Matrix4::from_fn(|r, c| at_gamma[(r, c)] + tr_dot(&gain, &bt_gamma, r, c));
+            let gamma_next = self.gamma[i + 1].fixed_columns::<M>(0).into_owned();
+            let bt_gamma = d.b_tr_left(&gamma_next);
+            let at_gamma = d.a_tr_left(&gamma_next);
+            let gamma = SMatrix::<f64, NX, M>::from_fn(|r, c| {
+                at_gamma[(r, c)] + tr_dot(&gain, &bt_gamma, r, c)
+            });
+            self.gamma[i].fixed_columns_mut::<M>(0).copy_from(&gamma);
             // W -= (BᵀΓ)ᵀ R̄⁻¹ (BᵀΓ).
             let r_bt_gamma = mul_2x2(&r_inv, &bt_gamma);
             w -= symmetric(|r, c| tr_dot(&bt_gamma, &r_bt_gamma, r, c));
             self.p[i] = p;
             self.gain[i] = gain;
             self.r_inv[i] = r_inv;
-            self.bt_gamma[i] = bt_gamma;
+            self.bt_gamma[i]
+                .fixed_columns_mut::<M>(0)
+                .copy_from(&bt_gamma);
         }
         // -W_0 on the m terminal rows; the unused rows get an identity.
-        let mut neg_w0 = -w;
+        let mut neg_w0 = Matrix4::zeros();
+        neg_w0.fixed_view_mut::<M, M>(0, 0).copy_from(&-w);
         let scale = (0..m).fold(0.0_f64, |s, j| s.max(neg_w0[(j, j)].abs()));
         for j in 0..NX {
             if j < m {
@@ -229,11 +253,25 @@ impl Riccati {
     }
 
     /// Solves the Newton system of the last [`factor`](Self::factor) for `rhs`.
-    pub fn solve(&mut self, dynamics: &[Dynamics], rhs: &Rhs<'_>, mut out: Step<'_>) {
+    pub fn solve(&mut self, dynamics: &[Dynamics], rhs: &Rhs<'_>, out: Step<'_>) {
+        if self.m <= TERMINAL_COLUMNS_USUAL {
+            self.solve_with::<TERMINAL_COLUMNS_USUAL>(dynamics, rhs, out);
+        } else {
+            self.solve_with::<NX>(dynamics, rhs, out);
+        }
+    }
+
+    /// [`solve`](Self::solve) with `Γ` on its first `M >= m` columns.
+    fn solve_with<const M: usize>(
+        &mut self,
+        dynamics: &[Dynamics],
+        rhs: &Rhs<'_>,
+        mut out: Step<'_>,
+    ) {
         let k = self.k;
         let mut p_next = rhs.linear[k].fixed_rows::<4>(0).into_owned();
         self.p_vec[k] = p_next;
-        let mut w = -rhs.terminal;
+        let mut w: SVector<f64, M> = -rhs.terminal.fixed_rows::<M>(0);
         // Slices of length `K`, bound once: no bounds checks in the loop (`p`, `gamma`
         // start at step 1, the cost-to-go after the step).
         let (p, gamma) = (&self.p[1..=k], &self.gamma[1..=k]);
@@ -248,10 +286,15 @@ impl Riccati {
             let kv = -(r_inv[i] * r_bar);
             p_next = linear[i].fixed_rows::<4>(0) + d.a_tr_mul(&pf) + gain[i].tr_mul(&r_bar);
             p_vec[i] = p_next;
-            w += gamma[i].tr_mul(f) + bt_gamma[i].tr_mul(&kv);
+            w += gamma[i].fixed_columns::<M>(0).tr_mul(f)
+                + bt_gamma[i].fixed_columns::<M>(0).tr_mul(&kv);
             k_vec[i] = kv;
         }
-        let mut nu = self.neg_w0_inv * (self.gamma[0].tr_mul(&rhs.initial) + w);
+        let mut gradient = Vector4::zeros();
+        gradient
+            .fixed_rows_mut::<M>(0)
+            .copy_from(&(self.gamma[0].fixed_columns::<M>(0).tr_mul(&rhs.initial) + w));
+        let mut nu = self.neg_w0_inv * gradient;
         for j in self.m..NX {
             nu[j] = 0.0;
         }
@@ -261,9 +304,9 @@ impl Riccati {
         // interior point cannot otherwise correct.
         for _ in 0..=TERMINAL_REFINEMENTS {
             if out.multipliers {
-                self.forward::<true>(dynamics, rhs, &nu, &mut out);
+                self.forward::<M, true>(dynamics, rhs, &nu, &mut out);
             } else {
-                self.forward::<false>(dynamics, rhs, &nu, &mut out);
+                self.forward::<M, false>(dynamics, rhs, &nu, &mut out);
             }
             let x_k = out.ux[self.k].fixed_rows::<4>(0).into_owned();
             let scale = 1.0 + x_k.amax() + rhs.terminal.amax();
@@ -280,7 +323,7 @@ impl Riccati {
 
     /// The forward pass for a given `ν`: controls, states and, with `MULTIPLIERS`, the
     /// multipliers.
-    fn forward<const MULTIPLIERS: bool>(
+    fn forward<const M: usize, const MULTIPLIERS: bool>(
         &self,
         dynamics: &[Dynamics],
         rhs: &Rhs<'_>,
@@ -289,8 +332,10 @@ impl Riccati {
     ) {
         let k = self.k;
         let mut x = rhs.initial;
+        let nu_m = nu.fixed_rows::<M>(0).into_owned();
         if MULTIPLIERS {
-            *out.y_initial = -(self.p[0] * x + self.p_vec[0] + self.gamma[0] * nu);
+            *out.y_initial =
+                -(self.p[0] * x + self.p_vec[0] + self.gamma[0].fixed_columns::<M>(0) * nu_m);
         }
         // Slices of length `K`, bound once (`p`, `p_vec`, `gamma` from step 1).
         let (p, p_vec, gamma) = (&self.p[1..=k], &self.p_vec[1..=k], &self.gamma[1..=k]);
@@ -300,11 +345,11 @@ impl Riccati {
         let (ux, y_dynamics) = (&mut out.ux[..k], &mut out.y_dynamics[..k]);
         for i in 0..k {
             let d = &dynamics[i].sparse;
-            let u = gain[i] * x + k_vec[i] - r_inv[i] * (bt_gamma[i] * nu);
+            let u = gain[i] * x + k_vec[i] - r_inv[i] * (bt_gamma[i].fixed_columns::<M>(0) * nu_m);
             ux[i] = Vector6::new(x[0], x[1], x[2], x[3], u[0], u[1]);
             x = d.a_mul(&x) + d.b_mul(&u) + offsets[i];
             if MULTIPLIERS {
-                y_dynamics[i] = -(p[i] * x + p_vec[i] + gamma[i] * nu);
+                y_dynamics[i] = -(p[i] * x + p_vec[i] + gamma[i].fixed_columns::<M>(0) * nu_m);
             }
         }
         out.ux[k] = Vector6::new(x[0], x[1], x[2], x[3], 0.0, 0.0);
@@ -316,24 +361,29 @@ impl Riccati {
 // general products and the symmetrization `(P + Pᵀ) / 2` took a fifth more of a
 // plan's time (measured with `examples/plan_latency.rs`).
 
-/// `(Mᵀ N)[r, c]` for two 2 x 4 blocks.
+/// `(Mᵀ N)[r, c]` for two blocks of two rows.
 #[inline(always)]
-fn tr_dot(m: &Matrix2x4<f64>, n: &Matrix2x4<f64>, r: usize, c: usize) -> f64 {
+fn tr_dot<const A: usize, const B: usize>(
+    m: &SMatrix<f64, 2, A>,
+    n: &SMatrix<f64, 2, B>,
+    r: usize,
+    c: usize,
+) -> f64 {
     m[(0, r)] * n[(0, c)] + m[(1, r)] * n[(1, c)]
 }
 
-/// `M N` for a 2 x 2 and a 2 x 4 block.
+/// `M N` for a 2 x 2 block and a block of two rows.
 #[inline(always)]
-fn mul_2x2(m: &Matrix2<f64>, n: &Matrix2x4<f64>) -> Matrix2x4<f64> {
-    Matrix2x4::from_fn(|r, c| m[(r, 0)] * n[(0, c)] + m[(r, 1)] * n[(1, c)])
+fn mul_2x2<const C: usize>(m: &Matrix2<f64>, n: &SMatrix<f64, 2, C>) -> SMatrix<f64, 2, C> {
+    SMatrix::<f64, 2, C>::from_fn(|r, c| m[(r, 0)] * n[(0, c)] + m[(r, 1)] * n[(1, c)])
 }
 
-/// The symmetric 4 x 4 matrix whose upper triangle is `entry(r, c)`, `r <= c`.
+/// The symmetric `N x N` matrix whose upper triangle is `entry(r, c)`, `r <= c`.
 #[inline(always)]
-fn symmetric(entry: impl Fn(usize, usize) -> f64) -> Matrix4<f64> {
-    let mut m = Matrix4::zeros();
-    for r in 0..NX {
-        for c in r..NX {
+fn symmetric<const N: usize>(entry: impl Fn(usize, usize) -> f64) -> SMatrix<f64, N, N> {
+    let mut m = SMatrix::<f64, N, N>::zeros();
+    for r in 0..N {
+        for c in r..N {
             let value = entry(r, c);
             m[(r, c)] = value;
             m[(c, r)] = value;
