@@ -353,7 +353,7 @@ impl StageQp {
             for (c, &v) in x[start..start + size].iter().enumerate() {
                 ux[c] = v;
             }
-            value += 0.5 * ux.dot(&(self.hessian[i] * ux)) + self.linear[i].dot(&ux);
+            value += 0.5 * ux.dot(&hessian_mul(&self.hessian[i], &ux)) + self.linear[i].dot(&ux);
         }
         let sigma = &x[self.slack_column(0)..];
         value
@@ -364,6 +364,24 @@ impl StageQp {
                 .map(|(c, s)| c * s)
                 .sum::<f64>()
     }
+}
+
+/// `H x` for a cost block of [`StageQp::assemble`], which writes only the diagonal and
+/// the `δ` row and column (`s δ`, `l δ`, `φ δ`: w7, w5, w6 of Eq. 34): 12 entries of 36,
+/// read at their fixed positions.
+#[inline(always)]
+pub(crate) fn hessian_mul(h: &Matrix6<f64>, x: &Vector6<f64>) -> Vector6<f64> {
+    use local::{DELTA, L, PHI, S};
+    let (hs, hl, hphi) = (h[(S, DELTA)], h[(L, DELTA)], h[(PHI, DELTA)]);
+    let delta = x[DELTA];
+    Vector6::new(
+        h[(0, 0)] * x[0] + hs * delta,
+        h[(1, 1)] * x[1],
+        h[(2, 2)] * x[2] + hl * delta,
+        h[(3, 3)] * x[3] + hphi * delta,
+        h[(4, 4)] * x[4],
+        h[(5, 5)] * delta + hs * x[S] + hl * x[L] + hphi * x[PHI],
+    )
 }
 
 /// `v` with `n` entries, all `value` (allocates only when `n` grows past the capacity).
@@ -381,5 +399,54 @@ pub(crate) fn pattern_of(problem: &Problem) -> Pattern {
             .map(|b| b.map_or((false, false), |b| (b.min.is_some(), b.max.is_some())))
             .collect(),
         terminal_s: problem.terminal.s.is_some(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{LateralBound, Position, State, Terminal, Tracking, Weights};
+    use proptest::prelude::*;
+
+    proptest! {
+        /// Every assembled cost block is zero outside the pattern [`hessian_mul`] reads,
+        /// and the product equals the dense one.
+        #[test]
+        fn assembled_cost_blocks_have_the_pattern_hessian_mul_reads(
+            column in prop::array::uniform10(-10.0..10.0f64),
+            tracking in prop::array::uniform4(0.0..10.0f64),
+            x in prop::array::uniform6(-50.0..50.0f64),
+            speed in 1.0..30.0f64,
+        ) {
+            let config = PlannerConfig { horizon: 8, ..PlannerConfig::default() };
+            let k = config.horizon;
+            let state = State { s: 100.0, v: speed, l: 0.5, phi: 0.01 };
+            let problem = Problem {
+                initial: state,
+                reference_speed: vec![speed; k],
+                curvature: 0.0,
+                weights: Weights::constant(k, column),
+                preceding: vec![Position { s: 130.0, l: 0.0 }; k],
+                adjacent: vec![Position { s: 90.0, l: 3.5 }; k],
+                terminal: Terminal { s: None, v: speed, l: 3.5 },
+                lateral_bounds: vec![Some(LateralBound::new(-1.75, 5.25)); k + 1],
+                tracking: Some(Tracking { weights: tracking, reference: vec![Some(state); k + 1] }),
+            };
+            let mut qp = StageQp::default();
+            qp.assemble(&config, &problem);
+            let x = Vector6::from(x);
+            for h in &qp.hessian {
+                for r in 0..NZ {
+                    for c in 0..NZ {
+                        let in_pattern = r == c || r == local::DELTA || c == local::DELTA;
+                        prop_assert!(in_pattern || h[(r, c)] == 0.0, "entry ({r}, {c}) = {}", h[(r, c)]);
+                    }
+                }
+                let (fast, dense) = (hessian_mul(h, &x), h * x);
+                for r in 0..NZ {
+                    prop_assert!((fast[r] - dense[r]).abs() <= 1e-12 * (1.0 + dense[r].abs()));
+                }
+            }
+        }
     }
 }

@@ -23,7 +23,7 @@ use super::head;
 use super::residuals::Residuals;
 use super::step::dual_step;
 use super::variables::{Direction, Variables, resize_keep};
-use crate::qp::StageQp;
+use crate::qp::{StageQp, hessian_mul};
 
 /// The Newton system's data, its factorization and its solve buffers.
 #[derive(Debug, Default)]
@@ -241,7 +241,7 @@ impl Kkt {
     pub fn refine(&mut self, qp: &StageQp, v: &Variables, r: &Residuals, d: &mut Direction) {
         let k = qp.k;
         for i in 0..=k {
-            self.e[i] = qp.hessian[i] * d.ux[i] + r.dual[i];
+            self.e[i] = hessian_mul(&qp.hessian[i], &d.ux[i]) + r.dual[i];
         }
         self.e_sigma.copy_from_slice(&r.dual_sigma);
         head(&mut self.e[0], &(d.y_initial - v.y_initial));

@@ -19,7 +19,7 @@ use nalgebra::{SVector, Vector4, Vector6};
 use super::head;
 use super::info::Measures;
 use super::variables::{Variables, resize_keep};
-use crate::qp::{NX, StageQp};
+use crate::qp::{NX, StageQp, hessian_mul};
 
 /// The residuals of the current iterate, in stage form.
 #[derive(Debug, Default)]
@@ -138,7 +138,7 @@ impl Residuals {
                 head(&mut self.dual[k], &qp.terminal.tr_mul(&v.y_terminal));
             }
             certificate_residual = max(certificate_residual, amax(&self.dual[i]));
-            let px = qp.hessian[i] * v.ux[i];
+            let px = hessian_mul(&qp.hessian[i], &v.ux[i]);
             xpx += v.ux[i].dot(&px);
             qx += qp.linear[i].dot(&v.ux[i]);
             let grad = px + qp.linear[i];
