@@ -357,9 +357,9 @@ impl Riccati {
     }
 }
 
-// The products of the backward pass, written out for its fixed sizes: nalgebra's
-// general products and the symmetrization `(P + Pᵀ) / 2` took a fifth more of a
-// plan's time (measured with `examples/plan_latency.rs`).
+// The products of the backward pass, written out for its fixed sizes: with nalgebra's
+// general products and the symmetrization `(P + Pᵀ) / 2` the pass took a fifth more
+// instructions (157.6 M against 128.0 M over 300 benchmark plans, callgrind).
 
 /// `(Mᵀ N)[r, c]` for two blocks of two rows.
 #[inline(always)]
