@@ -14,10 +14,12 @@
 /// [`CONTROL_REGULARIZATION_RELATIVE`]): keeps the recursion defined when the
 /// acceleration has no cost of its own.
 pub(crate) const CONTROL_REGULARIZATION: f64 = 1e-10;
-/// Regularization of every `R̄`, relative to its largest diagonal entry: a few units in
-/// the last place of that entry, enough to keep a `2 x 2` block that is positive
-/// semidefinite in exact arithmetic from rounding to a negative determinant, and too
-/// small to move a Newton step measurably.
+/// Regularization of each diagonal entry of `R̄`, relative to that entry: a few units in
+/// its last place, enough to keep a `2 x 2` block that is positive semidefinite in
+/// exact arithmetic from rounding to a negative determinant, and too small to move a
+/// Newton step measurably. Relative to the larger entry instead, an active steering
+/// bound (a steering entry of 1e20) swamped the acceleration's entry and a warm
+/// re-plan stalled off the optimum (`recursion.rs`, its test).
 pub(crate) const CONTROL_REGULARIZATION_RELATIVE: f64 = 1e-13;
 /// Regularization of the terminal Schur complement `-W_0`, relative to each row's own
 /// diagonal. Without an acceleration cost the rows of `s_K` and `v_K` are of order

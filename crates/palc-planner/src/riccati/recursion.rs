@@ -179,10 +179,10 @@ impl Riccati {
             let mut r00 = hi[(4, 4)] + bv * bv * p_next[(1, 1)] + diag[4];
             let r01 = hi[(4, 5)] + bv * bphi * p_next[(1, 3)];
             let mut r11 = hi[(5, 5)] + bphi * bphi * p_next[(3, 3)] + diag[5];
-            let scale = r00.abs().max(r11.abs());
-            let reg = CONTROL_REGULARIZATION + CONTROL_REGULARIZATION_RELATIVE * scale;
-            r00 += reg;
-            r11 += reg;
+            // Each diagonal entry regularized relative to itself: an active steering
+            // bound makes `r11` huge, and a regularization relative to it swamped `r00`.
+            r00 += CONTROL_REGULARIZATION + CONTROL_REGULARIZATION_RELATIVE * r00.abs();
+            r11 += CONTROL_REGULARIZATION + CONTROL_REGULARIZATION_RELATIVE * r11.abs();
             // Positive definite iff the leading entry and the determinant are positive;
             // then the closed-form 2 x 2 inverse.
             let det = r00 * r11 - r01 * r01;
@@ -405,4 +405,73 @@ fn semidefinite(p: Matrix4<f64>) -> Matrix4<f64> {
     let v = eigen.eigenvectors;
     let p = v * Matrix4::from_diagonal(&eigen.eigenvalues.map(|e| e.max(0.0))) * v.transpose();
     (p + p.transpose()) * 0.5
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::riccati::StepDynamics;
+
+    /// One step, no terminal rows: the acceleration's row of the Newton system is
+    /// solved to rounding however large the steering's diagonal (an active steering
+    /// bound, `W = λ / s` of 1e20 near the end of a warm re-plan). A regularization
+    /// relative to the larger diagonal entry moved the acceleration by 1e7 / 2 of its
+    /// own size, and a warm re-plan stalled 6e-6 above the optimum
+    /// (`tests/replan.proptest-regressions`, K = 22 with a fixed `s_K`).
+    #[test]
+    fn a_huge_steering_diagonal_leaves_the_acceleration_row_exact() {
+        for steering_diagonal in [0.0, 1e8, 1e14, 1e20] {
+            let mut riccati = Riccati::default();
+            riccati.resize(1);
+            let h = [
+                Matrix6::from_diagonal(&Vector6::new(1.0, 1.0, 1.0, 1.0, 2.0, 2.0)),
+                Matrix6::from_diagonal(&Vector6::new(1.0, 1.0, 1.0, 1.0, 0.0, 0.0)),
+            ];
+            let d = [
+                Vector6::new(0.0, 0.0, 0.0, 0.0, 0.0, steering_diagonal),
+                Vector6::zeros(),
+            ];
+            let dynamics = [Dynamics {
+                c: Vector4::zeros(),
+                sparse: StepDynamics {
+                    ds: 0.1,
+                    dl: 2.0,
+                    bv: 0.1,
+                    bphi: 0.8,
+                },
+            }];
+            riccati
+                .factor(&h, &d, &dynamics, &Matrix4::zeros(), 0)
+                .unwrap();
+            let linear = [
+                Vector6::new(0.0, 0.0, 0.0, 0.0, -1.5, 0.0),
+                Vector6::zeros(),
+            ];
+            let (mut ux, mut y_dynamics) = ([Vector6::zeros(); 2], [Vector4::zeros()]);
+            let (mut y_initial, mut y_terminal) = (Vector4::zeros(), Vector4::zeros());
+            riccati.solve(
+                &dynamics,
+                &Rhs {
+                    linear: &linear,
+                    offsets: &[Vector4::zeros()],
+                    initial: Vector4::zeros(),
+                    terminal: Vector4::zeros(),
+                },
+                Step {
+                    ux: &mut ux,
+                    y_dynamics: &mut y_dynamics,
+                    y_initial: &mut y_initial,
+                    y_terminal: &mut y_terminal,
+                    multipliers: true,
+                },
+            );
+            // Stationarity in a: (2 + bv² P_1[v, v]) a = 1.5 with P_1 = I.
+            let expected = 1.5 / (2.0 + 0.1 * 0.1);
+            let a = ux[0][4];
+            assert!(
+                (a - expected).abs() <= 1e-9 * expected,
+                "steering diagonal {steering_diagonal:e}: a = {a}, expected {expected}"
+            );
+        }
+    }
 }
