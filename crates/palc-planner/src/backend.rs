@@ -28,7 +28,8 @@ pub(crate) struct RawSolution {
     /// The primal variables `x` of the QP.
     pub primal: Vec<f64>,
     /// The multipliers `z` of all rows (clarabel's name), equality rows first (length
-    /// `m_eq + m_in`); on primal infeasibility, the certificate.
+    /// `m_eq + m_in`); on primal infeasibility, the certificate. Read only then: the
+    /// Riccati backend leaves it empty otherwise.
     pub multipliers: Vec<f64>,
     pub reused: bool,
     pub setup_seconds: f64,

@@ -66,11 +66,17 @@ impl RiccatiBackend {
             Outcome::PrimalInfeasible => RawStatus::PrimalInfeasible,
             Outcome::Failed(reason) => RawStatus::Failed(reason),
         };
+        // The multipliers are read only as an infeasibility certificate.
+        let multipliers = if matches!(status, RawStatus::PrimalInfeasible) {
+            self.multipliers(qp)
+        } else {
+            Vec::new()
+        };
         RawSolution {
             status,
             iterations: self.ipm.iterations,
             primal: self.primal(qp),
-            multipliers: self.multipliers(qp),
+            multipliers,
             reused,
             setup_seconds,
             solve_seconds,
