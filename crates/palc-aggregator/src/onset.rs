@@ -59,6 +59,15 @@ pub struct Onset {
     /// models). `None` without a leader at the start.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub accepted_lead_time_gap_s: Option<f64>,
+    /// The time headway (s) at the start itself when the start was read as a
+    /// wait for the target lane's follower (a start below the standard ALC's
+    /// decision headway with the follower's gap opening into it): `time_headway_s`
+    /// is then raised to the standard ALC's decision headway and `lag_time_gap_s`
+    /// holds the follower's gap. Kept so that the start can be read again as the
+    /// user's decision when another scene shows the user accepting a smaller
+    /// follower gap. `None` otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub follower_wait_time_headway_s: Option<f64>,
     /// Lessons this onset is the mean of.
     pub observations: u64,
 }
@@ -77,6 +86,10 @@ impl Onset {
             ("rejected_lead_time_gap_s", self.rejected_lead_time_gap_s),
             ("time_headway_ceiling_s", self.time_headway_ceiling_s),
             ("accepted_lead_time_gap_s", self.accepted_lead_time_gap_s),
+            (
+                "follower_wait_time_headway_s",
+                self.follower_wait_time_headway_s,
+            ),
         ];
         for (name, value) in values {
             if let Some(x) = value {
@@ -130,6 +143,10 @@ impl Onset {
                 (Some(x), Some(y)) => Some(x.min(y)),
                 (x, y) => x.or(y),
             },
+            follower_wait_time_headway_s: option(
+                self.follower_wait_time_headway_s,
+                other.follower_wait_time_headway_s,
+            ),
             observations: self.observations + other.observations,
         }
     }
@@ -151,6 +168,7 @@ mod tests {
             rejected_lead_time_gap_s: None,
             time_headway_ceiling_s: None,
             accepted_lead_time_gap_s: None,
+            follower_wait_time_headway_s: None,
             observations: n,
         }
     }

@@ -61,6 +61,7 @@ fn sample_experience() -> Experience {
         rejected_lead_time_gap_s: Some(0.42),
         time_headway_ceiling_s: None,
         accepted_lead_time_gap_s: Some(1.37),
+        follower_wait_time_headway_s: Some(0.88),
         observations: 2,
     }];
     experience.demonstration = Some((0..=20).map(|i| 3.5 * f64::from(i) / 20.0).collect());

@@ -270,6 +270,7 @@ pub(crate) fn onset_at(setup: &Setup, start_s: f64, before: &[Onset]) -> Option<
         rejected_lead_time_gap_s: None,
         time_headway_ceiling_s: None,
         accepted_lead_time_gap_s: lead_time_gap(&setup.situations[step]).filter(|g| g.is_finite()),
+        follower_wait_time_headway_s: None,
         observations: 1,
     };
     if onset.lag_time_gap_s.is_some() {
@@ -280,6 +281,7 @@ pub(crate) fn onset_at(setup: &Setup, start_s: f64, before: &[Onset]) -> Option<
         // `Setup::check_conservative`): the decision was taken at a headway of at
         // least the standard ALC's, and the follower's gap held the user back.
         onset.lag_time_gap_s = revealed(setup, step, lag_time_gap);
+        onset.follower_wait_time_headway_s = Some(onset.time_headway_s);
         onset.time_headway_s = onset.time_headway_s.max(setup.standard_alc.time_headway_s);
     }
     let mut onsets = before.to_vec();
@@ -434,6 +436,7 @@ impl Decision {
 /// decision); then the most consistent of those that no held-back onset
 /// contradicts.
 fn decision(onsets: &[Onset]) -> (Decision, f64) {
+    let onsets = &reread_follower_waits(onsets);
     let free: Vec<&Onset> = onsets
         .iter()
         .filter(|o| o.lead_time_gap_s.is_none() && o.lag_time_gap_s.is_none())
@@ -487,6 +490,37 @@ fn decision(onsets: &[Onset]) -> (Decision, f64) {
         }
     }
     (Decision::TimeHeadway, headway.1)
+}
+
+/// `onsets` with each start that was read as a wait for the follower
+/// ([`waited_for_the_follower`]) read again as the user's own decision when
+/// another onset started with a smaller follower gap than the one the wait
+/// learned (by more than [`CONSISTENT_SPREAD`]): a user who accepts that
+/// smaller gap did not wait for the larger one
+/// (the accepted gap bounds the needed one from above), so the start is where it
+/// decided, at the headway it had there. One scene cannot tell the two readings
+/// apart; a time-to-collision user who decides below the standard ALC's headway
+/// as the follower's gap opens looks like a user who waited for that gap
+/// (docs/paper-mapping.md, "A wait the standard ALC would not make").
+fn reread_follower_waits(onsets: &[Onset]) -> Vec<Onset> {
+    let smaller_lag_elsewhere = |i: usize, gap: f64| {
+        (onsets.iter().enumerate()).any(|(j, o)| {
+            j != i && (o.lag_time_gap_s).is_some_and(|g| g < gap * (1.0 - CONSISTENT_SPREAD))
+        })
+    };
+    (onsets.iter().enumerate())
+        .map(
+            |(i, o)| match (o.follower_wait_time_headway_s, o.lag_time_gap_s) {
+                (Some(headway), Some(gap)) if smaller_lag_elsewhere(i, gap) => Onset {
+                    time_headway_s: headway,
+                    lag_time_gap_s: None,
+                    follower_wait_time_headway_s: None,
+                    ..o.clone()
+                },
+                _ => o.clone(),
+            },
+        )
+        .collect()
 }
 
 /// The smallest target-lane time gap that held the user back in `onsets`, or 0
@@ -637,6 +671,7 @@ mod tests {
             rejected_lead_time_gap_s: None,
             time_headway_ceiling_s: None,
             accepted_lead_time_gap_s: None,
+            follower_wait_time_headway_s: None,
             observations: 1,
         }
     }
@@ -677,6 +712,42 @@ mod tests {
             decision(&[onset(0.89, 8.0, None), below]).0,
             Decision::TimeHeadway
         );
+    }
+
+    #[test]
+    fn a_wait_for_the_follower_is_the_decision_once_a_smaller_follower_gap_was_accepted() {
+        // The time-to-collision user above, whose start at a headway of 0.89 s came
+        // as the follower's gap opened (0.59 s): read as a wait for that gap, with
+        // the decision raised to the standard ALC's 1.0 s.
+        let waited = Onset {
+            follower_wait_time_headway_s: Some(0.89),
+            ..onset(1.0, 8.0, Some(0.59))
+        };
+        let alone = std::slice::from_ref(&waited);
+        assert_eq!(reread_follower_waits(alone), alone.to_vec());
+        assert_eq!(decision(alone), (Decision::TimeHeadway, 1.0));
+        // Another scene in which it started as soon as a follower had cleared (a
+        // gap of 0): it needs no 0.59 s behind, so the start was its decision.
+        let held = Onset {
+            gap_m: 10.0,
+            ..onset(1.41, 6.3, Some(0.0))
+        };
+        let reread = reread_follower_waits(&[waited.clone(), held.clone()]);
+        assert_eq!(reread[0].time_headway_s, 0.89);
+        assert_eq!(reread[0].lag_time_gap_s, None);
+        assert_eq!(reread[1], held);
+        assert_eq!(
+            decision(&[waited.clone(), held]),
+            (Decision::TimeToCollision, 8.0)
+        );
+        // A user that waited for about as large a gap in every scene keeps the
+        // reading.
+        let again = Onset {
+            follower_wait_time_headway_s: Some(0.7),
+            ..onset(1.0, 6.0, Some(0.62))
+        };
+        let both = [waited, again];
+        assert_eq!(reread_follower_waits(&both), both.to_vec());
     }
 
     #[test]
