@@ -383,3 +383,45 @@ fn a_start_after_the_standard_alc_waited_for_the_follower() {
     let carried = run(&target, Some(&experience), &mut NoObserver).expect("the run completes");
     assert_eq!(carried.summary.takeovers, 0);
 }
+
+#[test]
+fn a_wait_for_the_follower_that_a_later_scene_contradicts_is_read_again_as_the_decision() {
+    // A time-to-collision user (8 s, aggressive) starts in collector-high / 50 m /
+    // seed 1 at a time headway of 0.89 s as the follower's gap opens (0.59 s): read
+    // as a wait for that gap, with the decision raised to the standard ALC's 1.0 s.
+    // In collector-slow it waits for a follower alongside and starts as soon as it
+    // clears. Before the second scene contradicted the first reading, neither
+    // onset set the decision, the headway took the second scene's ceiling (1.68 s)
+    // and the carried start in arterial-high came 19 s early; read again, the
+    // first start is the decision, the headway is ruled out by the second, and the
+    // time to collision carries the start to the step.
+    let config = |speed_case: &str| {
+        let user = UserConfig::from_toml_str(
+            "[user]\nstyle = \"aggressive\"\nfamily = { start = { rule = \"time-to-collision\", seconds = 8.0 } }\n",
+            0.3,
+        )
+        .expect("the user parses");
+        LearnConfig::from_toml_str(include_str!("../../../configs/learn.toml"))
+            .expect("the default config parses")
+            .with_cell(CellChoice {
+                speed_case: speed_case.into(),
+                headway_m: 50.0,
+                seed: 1,
+            })
+            .with_user(user)
+    };
+    let first = learned_in(&config("collector-high"));
+    let onset = first.onsets.last().expect("an onset");
+    assert_eq!(onset.time_headway_s, 1.0, "read as a wait for the follower");
+    let waited = onset
+        .follower_wait_time_headway_s
+        .expect("the start's headway");
+    assert!((waited - 0.89).abs() < 0.01, "started at {waited} s");
+    let second = run(&config("collector-slow"), Some(&first), &mut NoObserver)
+        .expect("the run completes")
+        .experience;
+    let target = config("arterial-high");
+    assert_start_predicted_to_the_step(&target, &second, StylePreset::Aggressive);
+    let carried = run(&target, Some(&second), &mut NoObserver).expect("the run completes");
+    assert_eq!(carried.summary.takeovers, 0);
+}
