@@ -17,6 +17,17 @@ fn mean(values: &[f64]) -> Option<f64> {
     (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
 }
 
+/// palc's targets for experience across scenes (docs/paper-mapping.md,
+/// "Reproduction: how `cargo xtask reproduce-paper` counts"): the reduction of the
+/// mean takeovers with experience from another speed case (twice the paper's 24 %)
+/// and from another headway, with no pair more than one takeover worse than from
+/// scratch and none at the cap.
+const TARGET_REDUCTION_SPEED_CASE: f64 = 0.5;
+/// See [`TARGET_REDUCTION_SPEED_CASE`].
+const TARGET_REDUCTION_HEADWAY: f64 = 0.8;
+/// The target mean of the takeovers after the first scene of an accumulation chain.
+const TARGET_AFTER_FIRST_SCENE: f64 = 0.5;
+
 /// Which axis a transfer run crosses: the speed case or the headway.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Axis {
@@ -32,6 +43,14 @@ impl Axis {
         match self {
             Axis::SpeedCase => "speed case",
             Axis::Headway => "headway",
+        }
+    }
+
+    /// The target reduction of the mean takeovers with experience along this axis.
+    fn target_reduction(self) -> f64 {
+        match self {
+            Axis::SpeedCase => TARGET_REDUCTION_SPEED_CASE,
+            Axis::Headway => TARGET_REDUCTION_HEADWAY,
         }
     }
 
@@ -155,21 +174,23 @@ fn matrix(out: &mut String, rows: &[RunRow], method: Method, axis: Axis) {
     }
     // The diagonal holds each target's grid runs once per pair: the same runs,
     // repeated; their mean is the grid's mean over the paired cells.
+    let reduction = match (mean(&without), mean(&with)) {
+        (Some(a), Some(b)) if a > 0.0 => Some(1.0 - b / a),
+        _ => None,
+    };
     let _ = writeln!(
         out,
         "**`{}`, experience from another {}** ({} pairs): from scratch {} -> with experience {} \
-         takeovers ({}); {} pairs worse, {} not personalized.\n",
+         takeovers ({}); {} pairs worse, {} not personalized. {}\n",
         method.name(),
         axis.name(),
         with.len(),
         num(mean(&without), 2),
         num(mean(&with), 2),
-        match (mean(&without), mean(&with)) {
-            (Some(a), Some(b)) if a > 0.0 => format!("{:+.0} %", 100.0 * (b / a - 1.0)),
-            _ => "n/a".to_owned(),
-        },
+        reduction.map_or_else(|| "n/a".to_owned(), |r| format!("{:+.0} %", -100.0 * r)),
         worse,
-        capped
+        capped,
+        transfer_verdict(axis, reduction, worse, capped)
     );
     let _ = writeln!(out, "| from \\ to | {} |", labels.join(" | "));
     let _ = writeln!(out, "| --- |{}", " --- |".repeat(labels.len()));
@@ -188,6 +209,39 @@ fn matrix(out: &mut String, rows: &[RunRow], method: Method, axis: Axis) {
         let _ = writeln!(out, "| {from} | {} |", line.join(" | "));
     }
     let _ = writeln!(out);
+}
+
+/// The sentence that sets a transfer matrix's summary against palc's target.
+fn transfer_verdict(axis: Axis, reduction: Option<f64>, worse: usize, capped: usize) -> String {
+    let target = axis.target_reduction();
+    let met = reduction.is_some_and(|r| r >= target) && worse == 0 && capped == 0;
+    format!(
+        "Target: at least {:.0} % fewer, no pair worse, none not personalized: {}.",
+        100.0 * target,
+        if met { "met" } else { "**not met**" }
+    )
+}
+
+/// The sentence that sets the accumulation tables' means after the first scene
+/// against palc's target: the user kinds that meet it and those that do not.
+fn accumulation_verdict(after_first: &[(&str, Option<f64>)]) -> String {
+    let (met, missed): (Vec<_>, Vec<_>) = after_first
+        .iter()
+        .filter_map(|&(name, value)| value.map(|v| (name, v)))
+        .partition(|&(_, v)| v <= TARGET_AFTER_FIRST_SCENE);
+    let names = |kinds: &[(&str, f64)]| {
+        if kinds.is_empty() {
+            "none".to_owned()
+        } else {
+            kinds.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
+        }
+    };
+    format!(
+        "Target: at most {} takeovers after the first scene. Met by {}; **not met** by {}.",
+        TARGET_AFTER_FIRST_SCENE,
+        names(&met),
+        names(&missed)
+    )
 }
 
 /// The accumulation table of `method`, one per axis: mean takeovers of each user
@@ -215,6 +269,7 @@ fn accumulation(out: &mut String, rows: &[RunRow], method: Method) {
             places.join(" | ")
         );
         let _ = writeln!(out, "| --- |{} --- |", " --- |".repeat(scenes));
+        let mut after_first = Vec::new();
         for (name, by_place) in &kinds {
             let values: Vec<String> = (0..scenes)
                 .map(|p| {
@@ -231,8 +286,9 @@ fn accumulation(out: &mut String, rows: &[RunRow], method: Method) {
                 values.join(" | "),
                 num(mean(&following), 2)
             );
+            after_first.push((name.as_str(), mean(&following)));
         }
-        let _ = writeln!(out);
+        let _ = writeln!(out, "\n{}\n", accumulation_verdict(&after_first));
     }
 }
 
@@ -284,4 +340,37 @@ pub(crate) fn accumulation_places(
         places[place - 1].push(row.counted_takeovers() as f64);
     }
     kinds
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_transfer_meets_its_target_only_with_no_pair_worse_and_none_capped() {
+        let verdict = |axis, r, worse, capped| transfer_verdict(axis, Some(r), worse, capped);
+        assert!(verdict(Axis::SpeedCase, 0.5, 0, 0).ends_with(": met."));
+        assert!(verdict(Axis::SpeedCase, 0.49, 0, 0).contains("not met"));
+        assert!(verdict(Axis::SpeedCase, 0.9, 1, 0).contains("not met"));
+        assert!(verdict(Axis::SpeedCase, 0.9, 0, 1).contains("not met"));
+        assert!(verdict(Axis::Headway, 0.67, 0, 0).contains("at least 80 % fewer"));
+        assert!(verdict(Axis::Headway, 0.67, 0, 0).contains("not met"));
+        assert!(transfer_verdict(Axis::Headway, None, 0, 0).contains("not met"));
+    }
+
+    #[test]
+    fn the_accumulation_verdict_names_the_kinds_on_each_side() {
+        let line = accumulation_verdict(&[
+            ("deterministic", Some(0.27)),
+            ("ttc-start", Some(0.5)),
+            ("spread-2%", Some(5.47)),
+            ("empty", None),
+        ]);
+        assert!(
+            line.ends_with("Met by deterministic, ttc-start; **not met** by spread-2%."),
+            "{line}"
+        );
+        let all = accumulation_verdict(&[("deterministic", Some(0.1))]);
+        assert!(all.ends_with("**not met** by none."), "{all}");
+    }
 }
