@@ -5,8 +5,9 @@
 //! `palc eval`, in a release build, so the evaluation lives in one place
 //! (`crates/palc-eval`) and the task and the command give the same outputs: the
 //! paper's set-up (`configs/reproduce.toml`), then the same with the ACC and the
-//! safety layer (`configs/reproduce-safe.toml`, into `safe/`) and the stress scenes
-//! (`configs/stress/`, into `stress/<scene>/`).
+//! safety layer (`configs/reproduce-safe.toml`, into `safe/`), the stress scenes
+//! (`configs/stress/`, into `stress/<scene>/`) and `palc` on held-out seeds
+//! (`configs/reproduce-held-out.toml`, into `held-out/`).
 //! Repository hygiene lives in `tidy.rs` as ordinary tests, run by
 //! `cargo test --workspace`.
 
@@ -42,15 +43,17 @@ fn print_help() {
         "cargo xtask <task>\n\ntasks:\n  \
          reproduce-paper  regenerate the paper's evaluation (--quick, --jobs N, --out DIR, --config FILE);\n                   \
          the same as `palc eval` in a release build, then (without --config)\n                   \
-         configs/reproduce-safe.toml into DIR/safe and configs/stress/* into DIR/stress\n  \
+         configs/reproduce-safe.toml into DIR/safe, configs/stress/* into DIR/stress\n                   \
+         and configs/reproduce-held-out.toml into DIR/held-out\n  \
          help             this text"
     );
 }
 
 /// `cargo xtask reproduce-paper [flags]`: `palc eval [flags]`, built in release mode;
 /// without `--config`, then the same evaluation with the ego's ACC, the safety layer
-/// and users who wait for safe gaps, and the stress scenes under the same set-up
-/// ([`COMPANIONS`]), each written to its directory under the output directory.
+/// and users who wait for safe gaps, the stress scenes under the same set-up, and
+/// `palc` on held-out seeds ([`COMPANIONS`]), each written to its directory under
+/// the output directory.
 fn reproduce_paper(args: impl Iterator<Item = String>) -> anyhow::Result<()> {
     let args: Vec<String> = args.collect();
     palc_eval(&args)?;
@@ -90,8 +93,9 @@ const DEFAULT_OUT: &str = "target/reproduce-paper";
 
 /// The evaluations run after the paper's set-up, and their directories under the
 /// output directory: the ego's ACC, the safety layer and users who wait for safe
-/// gaps, then the stress scenes under the same set-up.
-const COMPANIONS: [(&str, &str); 4] = [
+/// gaps, then the stress scenes under the same set-up, then `palc` on seeds no
+/// figure uses.
+const COMPANIONS: [(&str, &str); 5] = [
     ("configs/reproduce-safe.toml", "safe"),
     (
         "configs/stress/braking-leader-eval.toml",
@@ -102,6 +106,7 @@ const COMPANIONS: [(&str, &str); 4] = [
         "stress/accelerating-lag",
     ),
     ("configs/stress/dense-eval.toml", "stress/dense"),
+    ("configs/reproduce-held-out.toml", "held-out"),
 ];
 
 /// `palc eval ARGS` in a release build.
