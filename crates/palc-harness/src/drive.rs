@@ -135,6 +135,9 @@ pub fn execute(
     // Where the system had driven the ego when the user took over: the plan's
     // state there, unless the longitudinal guard held the ego back.
     let mut at_takeover = plan.states[0];
+    // Steps the user has held its lateral position after the takeover, with a
+    // target-lane vehicle alongside: its lane change resumes this much later.
+    let mut held = 0;
     for i in 0..=k {
         let by_user = takeover_step.is_some_and(|step| i >= step);
         // The system's state at this step, while it drives (and at the takeover).
@@ -178,10 +181,15 @@ pub fn execute(
                 let acceleration =
                     guarded_user_acceleration(setup, &scene, previous.v, acceleration);
                 let moved = ballistic_step(previous.v, acceleration, dt);
+                let mut l = expected_l[i - held];
+                if enters_beside_a_vehicle(&scene, previous.l, l) {
+                    held += 1;
+                    l = previous.l;
+                }
                 State {
                     s: previous.s + moved.distance,
                     v: moved.speed,
-                    l: expected_l[i],
+                    l,
                     phi: 0.0,
                 }
             }
@@ -202,7 +210,7 @@ pub fn execute(
     if let Some(step) = takeover_step {
         for i in step..k {
             let run = (driven[i].v * dt).max(1e-9);
-            driven[i].phi = (expected_l[i + 1] - expected_l[i]) / run;
+            driven[i].phi = (driven[i + 1].l - driven[i].l) / run;
         }
     }
 
@@ -244,6 +252,27 @@ pub fn execute(
         user_safety: by_user_monitor.metrics(),
         user_speed_differs,
     })
+}
+
+/// Whether a user moving from the lateral position `from` to `to` would enter the
+/// target lane (the ego's footprint reaching into it) while a target-lane vehicle
+/// is alongside the ego, their lengths overlapping (a gap of zero or less): a
+/// driver does not steer into a vehicle beside it. The user, who took over after
+/// its own start, checked its gaps on the lane-keeping prediction; the system may
+/// have left the ego elsewhere (a plan that slowed down earlier), so it looks
+/// again before it moves over.
+fn enters_beside_a_vehicle(scene: &palc_traffic::Scene, from: f64, to: f64) -> bool {
+    let Some(ego) = scene.ego() else {
+        return false;
+    };
+    let (road, lane) = (scene.road(), palc_traffic::Lane(1));
+    let entering = to > from && road.occupies(to, ego.width, lane);
+    let beside = || {
+        let s = situation(scene);
+        s.target_lead_gap_m.is_some_and(|g| g <= 0.0)
+            || s.target_lag_gap_m.is_some_and(|g| g <= 0.0)
+    };
+    entering && !road.occupies(from, ego.width, lane) && beside()
 }
 
 /// The safety of `plan` driven to its end in a clone of the scene, with the other

@@ -151,3 +151,41 @@ proptest::proptest! {
         }
     }
 }
+
+/// collector-high / 30 m / seed 4 (a seed no figure uses), a cautious user who
+/// starts on a time to collision of 8 s: the first plan slows the ego behind the
+/// preceding vehicle earlier than the lane-keeping prediction on which the user
+/// chose its start, so that when the user takes over, after that start, the
+/// target lane's follower is alongside. The user holds its lateral position
+/// instead of steering into it (it collided before).
+#[test]
+fn a_user_who_takes_over_beside_the_follower_does_not_steer_into_it() {
+    let text = include_str!("../../../configs/learn.toml");
+    let user = UserConfig::from_toml_str(
+        "[user]\nstyle = \"cautious\"\nfamily = { start = { rule = \"time-to-collision\", seconds = 8.0 } }\n",
+        0.3,
+    )
+    .expect("the user parses");
+    let config = LearnConfig::from_toml_str(text)
+        .expect("the default config parses")
+        .with_method(Method::Palc)
+        .with_cell(CellChoice {
+            speed_case: "collector-high".to_owned(),
+            headway_m: 30.0,
+            seed: 4,
+        })
+        .with_user(user);
+    let mut lane_changes =
+        palc_harness::LearningLoop::new(&config, None).expect("the scene prepares");
+    let record = lane_changes
+        .step(&mut NoObserver)
+        .expect("the lane change runs")
+        .clone();
+    let takeover = record.takeover.as_ref().expect("the user takes over");
+    assert!(!record.user_safety.collision, "{:?}", record.user_safety);
+    // It held: the driven path stays below the expected one after the takeover.
+    let behind = (takeover.step..record.driven_l.len())
+        .filter(|&i| record.driven_l[i] < record.expected_l[i] - 0.1)
+        .count();
+    assert!(behind > 0, "the user never held its lateral position");
+}
