@@ -344,6 +344,21 @@ fn a_start_after_the_follower_has_left_is_a_decision_not_a_wait() {
     assert_start_predicted_to_the_step(&target, &experience, style);
 }
 
+/// The default learning config in `speed_case` / 50 m / `seed`, with the user of
+/// the `[user]` table whose body is `user` (a style and a family).
+fn family_at_50_m(user: &str, speed_case: &str, seed: u64) -> LearnConfig {
+    let user =
+        UserConfig::from_toml_str(&format!("[user]\n{user}\n"), 0.3).expect("the user parses");
+    LearnConfig::from_toml_str(include_str!("../../../configs/learn.toml"))
+        .expect("the default config parses")
+        .with_cell(CellChoice {
+            speed_case: speed_case.into(),
+            headway_m: 50.0,
+            seed,
+        })
+        .with_user(user)
+}
+
 #[test]
 fn a_start_after_the_standard_alc_waited_for_the_follower() {
     // A user who needs 0.5 s behind (the perceived-safety family) starts in
@@ -355,19 +370,11 @@ fn a_start_after_the_standard_alc_waited_for_the_follower() {
     // the standard ALC's), the carried start is the user's to the step, and the
     // first lane change there needs no takeover.
     let config = |speed_case: &str| {
-        let user = UserConfig::from_toml_str(
-            "[user]\nstyle = \"neutral\"\nfamily = { min_lead_gap_s = 0.8, min_lag_gap_s = 0.5 }\n",
-            0.3,
+        family_at_50_m(
+            "style = \"neutral\"\nfamily = { min_lead_gap_s = 0.8, min_lag_gap_s = 0.5 }",
+            speed_case,
+            2,
         )
-        .expect("the user parses");
-        LearnConfig::from_toml_str(include_str!("../../../configs/learn.toml"))
-            .expect("the default config parses")
-            .with_cell(CellChoice {
-                speed_case: speed_case.into(),
-                headway_m: 50.0,
-                seed: 2,
-            })
-            .with_user(user)
     };
     let experience = learned_in(&config("collector-high"));
     let onset = experience.onsets.last().expect("an onset");
@@ -396,19 +403,11 @@ fn a_wait_for_the_follower_that_a_later_scene_contradicts_is_read_again_as_the_d
     // first start is the decision, the headway is ruled out by the second, and the
     // time to collision carries the start to the step.
     let config = |speed_case: &str| {
-        let user = UserConfig::from_toml_str(
-            "[user]\nstyle = \"aggressive\"\nfamily = { start = { rule = \"time-to-collision\", seconds = 8.0 } }\n",
-            0.3,
+        family_at_50_m(
+            "style = \"aggressive\"\nfamily = { start = { rule = \"time-to-collision\", seconds = 8.0 } }",
+            speed_case,
+            1,
         )
-        .expect("the user parses");
-        LearnConfig::from_toml_str(include_str!("../../../configs/learn.toml"))
-            .expect("the default config parses")
-            .with_cell(CellChoice {
-                speed_case: speed_case.into(),
-                headway_m: 50.0,
-                seed: 1,
-            })
-            .with_user(user)
     };
     let first = learned_in(&config("collector-high"));
     let onset = first.onsets.last().expect("an onset");
