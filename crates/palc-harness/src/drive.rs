@@ -182,7 +182,7 @@ pub fn execute(
                     guarded_user_acceleration(setup, &scene, previous.v, acceleration);
                 let moved = ballistic_step(previous.v, acceleration, dt);
                 let mut l = expected_l[i - held];
-                if enters_beside_a_vehicle(&scene, previous.l, l) {
+                if enters_beside_a_vehicle(&scene, setup.target_l, previous.l, l) {
                     held += 1;
                     l = previous.l;
                 }
@@ -261,11 +261,12 @@ pub fn execute(
 /// its own start, checked its gaps on the lane-keeping prediction; the system may
 /// have left the ego elsewhere (a plan that slowed down earlier), so it looks
 /// again before it moves over.
-fn enters_beside_a_vehicle(scene: &palc_traffic::Scene, from: f64, to: f64) -> bool {
+fn enters_beside_a_vehicle(scene: &palc_traffic::Scene, target_l: f64, from: f64, to: f64) -> bool {
     let Some(ego) = scene.ego() else {
         return false;
     };
-    let (road, lane) = (scene.road(), palc_traffic::Lane(1));
+    let road = scene.road();
+    let lane = road.nearest_lane(target_l);
     let entering = to > from && road.occupies(to, ego.width, lane);
     let beside = || {
         let s = situation(scene);
