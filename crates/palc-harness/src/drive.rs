@@ -8,7 +8,7 @@ use crate::acc::acc_leader;
 use crate::guard::{drive_states, guarded_step, guarded_user_acceleration};
 use crate::record::Takeover;
 use crate::safety::{SafetyMetrics, SafetyMonitor};
-use crate::setup::{Setup, situation};
+use crate::setup::{Setup, situation, target_gaps_safe};
 use crate::user::{Expectation, ExpectedLaneChange, TakeoverCause, User, max_deviation};
 
 /// The planning problem of this scenario with the given weights and lateral bounds.
@@ -163,8 +163,9 @@ pub fn execute(
             (true, Some(previous)) => {
                 // Until its lane change ends, the user moves as the lane-keeping
                 // prediction does, gap seeking included: the motion on which it
-                // chose its start and checked its gaps.
-                let acc = if i <= seeking_until {
+                // chose its start and checked its gaps. A lane change held back
+                // (below) ends that much later, and the user seeks a gap meanwhile.
+                let acc = if i <= seeking_until + held {
                     setup.lane_keeping_acceleration(&scene, i - 1)
                 } else {
                     (setup.acc).ego_acceleration(
@@ -181,17 +182,17 @@ pub fn execute(
                 let acceleration =
                     guarded_user_acceleration(setup, &scene, previous.v, acceleration);
                 let moved = ballistic_step(previous.v, acceleration, dt);
-                let mut l = expected_l[i - held];
-                if enters_beside_a_vehicle(&scene, setup.target_l, previous.l, l) {
-                    held += 1;
-                    l = previous.l;
-                }
-                State {
+                let mut next = State {
                     s: previous.s + moved.distance,
                     v: moved.speed,
-                    l,
+                    l: expected_l[i - held],
                     phi: 0.0,
+                };
+                if holds_before_entering(setup, &scene, previous.l, &next)? {
+                    held += 1;
+                    next.l = previous.l;
                 }
+                next
             }
         };
         if i > 0 {
@@ -255,25 +256,41 @@ pub fn execute(
 }
 
 /// Whether a user moving from the lateral position `from` to `to` would enter the
-/// target lane (the ego's footprint reaching into it) while a target-lane vehicle
-/// is alongside the ego, their lengths overlapping (a gap of zero or less): a
-/// driver does not steer into a vehicle beside it. The user, who took over after
-/// its own start, checked its gaps on the lane-keeping prediction; the system may
-/// have left the ego elsewhere (a plan that slowed down earlier), so it looks
-/// again before it moves over.
-fn enters_beside_a_vehicle(scene: &palc_traffic::Scene, target_l: f64, from: f64, to: f64) -> bool {
+/// target lane (the ego's footprint reaching into it) at a gap it does not enter:
+/// beside a target-lane vehicle, their lengths overlapping (a gap of zero or less),
+/// for every user, since a driver does not steer into a vehicle beside it; below the
+/// RSS safe distance to the target lane's lead or lag vehicle, for users who wait
+/// for safe gaps (`planning.safety.users_wait_for_safe_gaps`), who check their
+/// mirror again before they move over as they did before their start. The user,
+/// who took over after its own start, checked its gaps on the lane-keeping
+/// prediction; the system may have left the ego elsewhere (a plan that slowed down
+/// earlier), or a target-lane vehicle may have accelerated into the gap since
+/// (`traffic.testbed.lag_accelerating`), so it looks again before it moves over.
+fn holds_before_entering(
+    setup: &Setup,
+    scene: &palc_traffic::Scene,
+    from: f64,
+    next: &State,
+) -> Result<bool, HarnessError> {
     let Some(ego) = scene.ego() else {
-        return false;
+        return Ok(false);
     };
     let road = scene.road();
-    let lane = road.nearest_lane(target_l);
-    let entering = to > from && road.occupies(to, ego.width, lane);
-    let beside = || {
-        let s = situation(scene);
-        s.target_lead_gap_m.is_some_and(|g| g <= 0.0)
-            || s.target_lag_gap_m.is_some_and(|g| g <= 0.0)
-    };
-    entering && !road.occupies(from, ego.width, lane) && beside()
+    let lane = road.nearest_lane(setup.target_l);
+    if next.l <= from
+        || road.occupies(from, ego.width, lane)
+        || !road.occupies(next.l, ego.width, lane)
+    {
+        return Ok(false);
+    }
+    // The user judges the gaps where the move would put the ego, as the other
+    // vehicles would then be (one step of the scene ahead, on a clone).
+    let mut ahead = scene.clone();
+    ahead.step(setup.dt, ego_state(setup, next))?;
+    let s = situation(&ahead);
+    let beside = s.target_lead_gap_m.is_some_and(|g| g <= 0.0)
+        || s.target_lag_gap_m.is_some_and(|g| g <= 0.0);
+    Ok(beside || (setup.safety.users_wait_for_safe_gaps && !target_gaps_safe(&s, &setup.safety)))
 }
 
 /// The safety of `plan` driven to its end in a clone of the scene, with the other

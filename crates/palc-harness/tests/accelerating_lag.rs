@@ -10,7 +10,7 @@ use palc_harness::{
 
 const STRESS: &str = include_str!("../../../configs/stress/accelerating-lag.toml");
 
-/// The stress scene's cell collector-high / 50 m / seed 1 with a neutral user, the
+/// The stress scene's cell collector-high / 50 m / seed 1 with an aggressive user, the
 /// ACC, the safety layer and users who start only into safe gaps on, as
 /// `configs/learn-safe.toml` has them.
 fn config() -> LearnConfig {
@@ -22,7 +22,7 @@ fn config() -> LearnConfig {
     config.planning.safety.users_wait_for_safe_gaps = true;
     config.planning.acc.enabled = true;
     config.planning.standard_alc.min_lag_gap_s = 0.8;
-    config.with_user(UserConfig::preset(StylePreset::Neutral))
+    config.with_user(UserConfig::preset(StylePreset::Aggressive))
 }
 
 /// Keeps the refusal events the loop reports.
@@ -133,4 +133,32 @@ fn in_closed_loop_the_safety_layer_checks_every_replan_in_the_same_scene() {
         records[1].safety_refusal.map(|v| v.role),
         Some(Role::TargetLag)
     );
+}
+
+#[test]
+fn a_user_who_waits_for_safe_gaps_does_not_move_in_ahead_of_a_lag_vehicle_that_closed_the_gap() {
+    // The user takes over the first lane change (the standard ALC's plan starts
+    // after it) and drives its own; the lag vehicle accelerates once the ego is
+    // 0.3 m over. The user looks again before its footprint enters the target
+    // lane and holds its lateral position while the gap is below the RSS
+    // distance, as it waited for a safe gap before its start.
+    let (records, _) = drive(&config(), 2);
+    let first = &records[0];
+    assert!(
+        first.takeover.is_some(),
+        "the user drives the first lane change"
+    );
+    assert_eq!(
+        first.user_safety.rss_violations, 0,
+        "{:?}",
+        first.user_safety
+    );
+    assert!(!first.user_safety.collision);
+    // It held: the driven path lags the expected one somewhere.
+    let held = first
+        .driven_l
+        .iter()
+        .zip(&first.expected_l)
+        .any(|(driven, expected)| expected - driven > 0.3);
+    assert!(held, "the user's path was never held back");
 }
