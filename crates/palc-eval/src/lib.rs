@@ -49,6 +49,7 @@ pub mod results;
 pub mod runner;
 pub mod safety_report;
 pub mod stats;
+pub mod timing_report;
 pub mod transfer_report;
 pub mod views;
 

@@ -9,9 +9,9 @@ use palc_harness::Method;
 use crate::claims::{CLAIMS, Runs, num, pct};
 use crate::harness_runs::ExampleTrace;
 use crate::manifest::Manifest;
-use crate::results::{PART_NAMES, RunRow, Status};
+use crate::results::{RunRow, Status};
 use crate::stats::{self, Summary};
-use crate::views::{self, FigureFile, grid, speed_label, with_transfer};
+use crate::views::{FigureFile, grid, speed_label, with_transfer};
 
 /// Everything the report is made of.
 pub struct ReportInput<'a> {
@@ -72,7 +72,7 @@ pub fn render(input: &ReportInput) -> String {
     crate::closed_loop_report::section(&mut out, input.rows, input.methods, input.users);
     refusals(&mut out, input.rows);
     learning_failures(&mut out, input);
-    timing_section(&mut out, input);
+    crate::timing_report::section(&mut out, input.rows, input.methods);
     example_section(&mut out, input);
     let _ = writeln!(out, "## Figures\n");
     for figure in input.figures {
@@ -411,63 +411,6 @@ fn cause_kind(error: &str) -> &str {
         Some((end, _)) => &error[..end],
         None => error,
     }
-}
-
-fn timing_section(out: &mut String, input: &ReportInput) {
-    let _ = writeln!(out, "## Compute time per iteration (Fig. 13)\n");
-    let _ = writeln!(
-        out,
-        "Measured with `std::time::Instant` around each part of each iteration, on this machine, \
-         in a release build, several runs in parallel; the paper: 0.08 s mean and below 0.13 s up to \
-         K = 120 at dt = 0.05 s (MATLAB). Times in ms.\n"
-    );
-    let parts = PART_NAMES.map(|p| format!("{p} mean"));
-    let _ = writeln!(
-        out,
-        "| method | dt (s) | K | iterations | mean | p50 | p95 | max | {} |",
-        parts.join(" | ")
-    );
-    let _ = writeln!(
-        out,
-        "| --- | --- | --- | --- | --- | --- | --- | --- |{}",
-        " --- |".repeat(5)
-    );
-    for &method in input.methods {
-        let timed = views::timing(input.rows, method);
-        let mut keys: Vec<(u64, usize)> = timed
-            .iter()
-            .filter_map(|r| r.dt.map(|dt| (dt.to_bits(), r.horizon)))
-            .collect();
-        keys.sort_by(|a, b| {
-            f64::from_bits(b.0)
-                .total_cmp(&f64::from_bits(a.0))
-                .then(a.1.cmp(&b.1))
-        });
-        keys.dedup();
-        for (dt_bits, k) in keys {
-            let group = timed
-                .iter()
-                .copied()
-                .filter(|r| r.dt.map(f64::to_bits) == Some(dt_bits) && r.horizon == k);
-            let Some(t) = stats::timing(group) else {
-                continue;
-            };
-            let ms = |v: f64| format!("{:.2}", v * 1e3);
-            let _ = writeln!(
-                out,
-                "| {} | {} | {k} | {} | {} | {} | {} | {} | {} |",
-                method.name(),
-                f64::from_bits(dt_bits),
-                t.iterations,
-                ms(t.mean),
-                ms(t.p50),
-                ms(t.p95),
-                ms(t.max),
-                t.part_means.map(ms).join(" | ")
-            );
-        }
-    }
-    let _ = writeln!(out);
 }
 
 fn example_section(out: &mut String, input: &ReportInput) {

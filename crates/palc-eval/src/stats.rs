@@ -231,6 +231,11 @@ pub fn percentile(sorted: &[f64], q: f64) -> f64 {
 /// Timing of every iteration of `rows`; `None` without iterations.
 pub fn timing<'a>(rows: impl IntoIterator<Item = &'a RunRow>) -> Option<Timing> {
     let iterations: Vec<&Iteration> = rows.into_iter().flat_map(|r| &r.iterations).collect();
+    timing_of(&iterations)
+}
+
+/// Timing of `iterations`; `None` without any.
+pub fn timing_of(iterations: &[&Iteration]) -> Option<Timing> {
     if iterations.is_empty() {
         return None;
     }
