@@ -1,7 +1,7 @@
 //! One lane change: plan, execute in the scene, let the user judge each step.
 
 use palc_planner::{LateralBound, Plan, Position, Problem, State, Terminal, Weights};
-use palc_traffic::{EgoState, ballistic_step};
+use palc_traffic::{EgoState, Scene, ballistic_step};
 
 use crate::HarnessError;
 use crate::acc::acc_leader;
@@ -129,9 +129,15 @@ pub fn execute(
         p.map_or([1e4, 0.0], |v| [v.state.s - setup.origin_s, v.state.l])
     };
     let mut user_speed_differs = false;
-    let seeking_until = (expectation.lane_change.end_s() / dt - 1e-9)
-        .ceil()
-        .max(0.0) as usize;
+    let driving = UserDriving {
+        setup,
+        user,
+        expectation,
+        expected_l: &expected_l,
+        seeking_until: (expectation.lane_change.end_s() / dt - 1e-9)
+            .ceil()
+            .max(0.0) as usize,
+    };
     // Where the system had driven the ego when the user took over: the plan's
     // state there, unless the longitudinal guard held the ego back.
     let mut at_takeover = plan.states[0];
@@ -161,34 +167,9 @@ pub fn execute(
                 ..plan.states[0]
             },
             (true, Some(previous)) => {
-                // Until its lane change ends, the user moves as the lane-keeping
-                // prediction does, gap seeking included: the motion on which it
-                // chose its start and checked its gaps. A lane change held back
-                // (below) ends that much later, and the user seeks a gap meanwhile.
-                let acc = if i <= seeking_until + held {
-                    setup.lane_keeping_acceleration(&scene, i - 1)
-                } else {
-                    (setup.acc).ego_acceleration(
-                        previous.v,
-                        setup.set_speed,
-                        acc_leader(&scene),
-                        &setup.safety,
-                    )
-                };
-                let acceleration =
-                    user.acceleration_after_takeover(expectation, i, previous.v, acc);
-                // Exact: a user who leaves its speed to the ACC returns its command.
-                user_speed_differs |= acceleration != acc;
-                let acceleration =
-                    guarded_user_acceleration(setup, &scene, previous.v, acceleration);
-                let moved = ballistic_step(previous.v, acceleration, dt);
-                let mut next = State {
-                    s: previous.s + moved.distance,
-                    v: moved.speed,
-                    l: expected_l[i - held],
-                    phi: 0.0,
-                };
-                if holds_before_entering(setup, &scene, previous.l, &next)? {
+                let (mut next, differs) = driving.step(&scene, previous, i, held);
+                user_speed_differs |= differs;
+                if driving.holds_before_entering(&scene, previous, &next, i, held)? {
                     held += 1;
                     next.l = previous.l;
                 }
@@ -255,42 +236,113 @@ pub fn execute(
     })
 }
 
-/// Whether a user moving from the lateral position `from` to `to` would enter the
-/// target lane (the ego's footprint reaching into it) at a gap it does not enter:
-/// beside a target-lane vehicle, their lengths overlapping (a gap of zero or less),
-/// for every user, since a driver does not steer into a vehicle beside it; below the
-/// RSS safe distance to the target lane's lead or lag vehicle, for users who wait
-/// for safe gaps (`planning.safety.users_wait_for_safe_gaps`), who check their
-/// mirror again before they move over as they did before their start. The user,
-/// who took over after its own start, checked its gaps on the lane-keeping
-/// prediction; the system may have left the ego elsewhere (a plan that slowed down
-/// earlier), or a target-lane vehicle may have accelerated into the gap since
-/// (`traffic.testbed.lag_accelerating`), so it looks again before it moves over.
-fn holds_before_entering(
-    setup: &Setup,
-    scene: &palc_traffic::Scene,
-    from: f64,
-    next: &State,
-) -> Result<bool, HarnessError> {
-    let Some(ego) = scene.ego() else {
-        return Ok(false);
-    };
-    let road = scene.road();
-    let lane = road.nearest_lane(setup.target_l);
-    if next.l <= from
-        || road.occupies(from, ego.width, lane)
-        || !road.occupies(next.l, ego.width, lane)
-    {
-        return Ok(false);
+/// How the simulated user drives after its takeover: its expected lateral path,
+/// held back by the steps it waited before moving over, at its own acceleration.
+struct UserDriving<'a> {
+    setup: &'a Setup,
+    user: &'a dyn User,
+    expectation: &'a Expectation,
+    /// Expected lateral positions at steps `0..=K`.
+    expected_l: &'a [f64],
+    /// The step at which the expected lane change ends.
+    seeking_until: usize,
+}
+
+impl UserDriving<'_> {
+    /// The user's state at step `i` after `previous`, its lateral path `held` steps
+    /// late, and whether its acceleration differs from the ego ACC's.
+    ///
+    /// Until its lane change ends, the user moves as the lane-keeping prediction
+    /// does, gap seeking included: the motion on which it chose its start and
+    /// checked its gaps. A lane change held back ends that much later, and the user
+    /// seeks a gap meanwhile; after it, the ACC drives (a speed-matching user's own
+    /// rule capped by either), under the longitudinal guard.
+    fn step(&self, scene: &Scene, previous: &State, i: usize, held: usize) -> (State, bool) {
+        let setup = self.setup;
+        let acc = if i <= self.seeking_until + held {
+            setup.lane_keeping_acceleration(scene, i - 1)
+        } else {
+            (setup.acc).ego_acceleration(
+                previous.v,
+                setup.set_speed,
+                acc_leader(scene),
+                &setup.safety,
+            )
+        };
+        let chosen = (self.user).acceleration_after_takeover(self.expectation, i, previous.v, acc);
+        // Exact: a user who leaves its speed to the ACC returns its command.
+        let differs = chosen != acc;
+        let acceleration = guarded_user_acceleration(setup, scene, previous.v, chosen);
+        let moved = ballistic_step(previous.v, acceleration, setup.dt);
+        let next = State {
+            s: previous.s + moved.distance,
+            v: moved.speed,
+            l: self.expected_l[i - held],
+            phi: 0.0,
+        };
+        (next, differs)
     }
-    // The user judges the gaps where the move would put the ego, as the other
-    // vehicles would then be (one step of the scene ahead, on a clone).
-    let mut ahead = scene.clone();
-    ahead.step(setup.dt, ego_state(setup, next))?;
-    let s = situation(&ahead);
-    let beside = s.target_lead_gap_m.is_some_and(|g| g <= 0.0)
-        || s.target_lag_gap_m.is_some_and(|g| g <= 0.0);
-    Ok(beside || (setup.safety.users_wait_for_safe_gaps && !target_gaps_safe(&s, &setup.safety)))
+
+    /// Whether the user, at `previous` in `scene`, holds its lateral position
+    /// instead of moving to `next` (step `i`, its path `held` steps late): the move
+    /// would bring the ego's footprint into the target lane at a gap it does not
+    /// enter. Every user holds beside a target-lane vehicle (their lengths
+    /// overlapping one step ahead, a gap of zero or less): a driver does not steer
+    /// into a vehicle beside it. A user who waits for safe gaps
+    /// (`planning.safety.users_wait_for_safe_gaps`) also holds when its lane change
+    /// from here, driven on a clone of the scene to the horizon's end, would bring
+    /// the target lane's lead or lag vehicle below the RSS safe distance while the
+    /// ego occupies that lane: the check of its start, made again. The user took
+    /// over after its own start, which it checked on the lane-keeping prediction;
+    /// the system may have left the ego elsewhere (a plan that slowed down
+    /// earlier), or a target-lane vehicle may have accelerated into the gap since
+    /// (`traffic.testbed.lag_accelerating`).
+    fn holds_before_entering(
+        &self,
+        scene: &Scene,
+        previous: &State,
+        next: &State,
+        i: usize,
+        held: usize,
+    ) -> Result<bool, HarnessError> {
+        let setup = self.setup;
+        let Some(ego) = scene.ego() else {
+            return Ok(false);
+        };
+        let road = scene.road();
+        let lane = road.nearest_lane(setup.target_l);
+        let width = ego.width;
+        if next.l <= previous.l
+            || road.occupies(previous.l, width, lane)
+            || !road.occupies(next.l, width, lane)
+        {
+            return Ok(false);
+        }
+        let mut ahead = scene.clone();
+        ahead.step(setup.dt, ego_state(setup, next))?;
+        let seen = situation(&ahead);
+        let beside = seen.target_lead_gap_m.is_some_and(|g| g <= 0.0)
+            || seen.target_lag_gap_m.is_some_and(|g| g <= 0.0);
+        if beside {
+            return Ok(true);
+        }
+        let safety = &setup.safety;
+        if !safety.users_wait_for_safe_gaps {
+            return Ok(false);
+        }
+        let mut state = *next;
+        for j in i..=setup.horizon {
+            if j > i {
+                state = self.step(&ahead, &state, j, held).0;
+                ahead.step(setup.dt, ego_state(setup, &state))?;
+            }
+            if road.occupies(state.l, width, lane) && !target_gaps_safe(&situation(&ahead), safety)
+            {
+                return Ok(true);
+            }
+        }
+        Ok(false)
+    }
 }
 
 /// The safety of `plan` driven to its end in a clone of the scene, with the other

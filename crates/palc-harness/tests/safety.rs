@@ -410,3 +410,43 @@ fn users_own_lane_changes_keep_the_safe_distance(
     assert_eq!(palc.summary.takeovers, 1);
     assert!(palc.records.iter().all(|r| r.safety_refusal.is_none()));
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(32))]
+
+    /// Over random cells of the safe set-up, with and without a target-lane
+    /// follower that accelerates into the gap (`configs/stress/accelerating-lag.toml`),
+    /// a user who waits for safe gaps and takes over the first lane change (the
+    /// standard ALC's, which starts after every user) drives its own lane change at
+    /// the RSS distance: it started at it, and it looks again before it moves over.
+    #[test]
+    fn a_user_who_waits_for_safe_gaps_never_drives_below_the_safe_distance(
+        case in 0usize..4,
+        headway_m in 30.0f64..50.0,
+        seed in 1u64..500,
+        style in 0usize..3,
+        accelerating_lag in proptest::bool::ANY,
+    ) {
+        use palc_harness::{CellChoice, LearnConfig, LearningLoop, NoObserver, StylePreset, UserConfig};
+
+        let text = if accelerating_lag {
+            include_str!("../../../configs/stress/accelerating-lag.toml")
+        } else {
+            include_str!("../../../configs/learn-safe.toml")
+        };
+        let speed_case = ["collector-high", "collector-slow", "arterial-high", "arterial-slow"][case];
+        let config = LearnConfig::from_toml_str(text)
+            .expect("the config parses")
+            .with_cell(CellChoice { speed_case: speed_case.into(), headway_m, seed })
+            .with_user(UserConfig::preset(StylePreset::ALL[style]));
+        proptest::prop_assert!(config.planning.safety.users_wait_for_safe_gaps);
+        // A scene with no safe lane change within the window is refused, not run.
+        let run = LearningLoop::new(&config, None);
+        proptest::prop_assume!(run.is_ok());
+        let mut run = run.expect("checked");
+        let record = run.step(&mut NoObserver).expect("the lane change runs");
+        proptest::prop_assert!(!record.user_safety.collision, "{:?}", record.user_safety);
+        proptest::prop_assert_eq!(record.user_safety.rss_violations, 0, "{:?}", record.user_safety);
+        proptest::prop_assert!(record.safety.is_safe(), "{:?}", record.safety);
+    }
+}
