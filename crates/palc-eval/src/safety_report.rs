@@ -42,6 +42,7 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
         out,
         "| --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- | --- |"
     );
+    let mut totals = Totals::default();
     for experiment in [
         Experiment::Grid,
         Experiment::Transfer,
@@ -73,15 +74,22 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
                 }
                 _ => format!("`{}`", method.name()),
             };
+            let counts = Totals {
+                system_collisions: count(&|i| i.safety.collision),
+                system_violations: count(&|i| i.safety.rss_violations > 0),
+                user_collisions: count(&|i| i.user_safety.collision),
+                user_violations: count(&|i| i.user_safety.rss_violations > 0),
+            };
+            totals.add(&counts);
             let _ = writeln!(
                 out,
                 "| {} | {who} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                 experiment.name(),
                 iterations.len(),
-                count(&|i| i.safety.collision),
-                count(&|i| i.safety.rss_violations > 0),
-                count(&|i| i.user_safety.collision),
-                count(&|i| i.user_safety.rss_violations > 0),
+                counts.system_collisions,
+                counts.system_violations,
+                counts.user_collisions,
+                counts.user_violations,
                 count(&|i| i.safety_refusal.is_some()),
                 distribution(&|s| s.min_gap_preceding_m),
                 distribution(&|s| s.min_gap_target_lead_m),
@@ -91,6 +99,7 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
         }
     }
     let _ = writeln!(out);
+    let _ = writeln!(out, "{}\n", verdict(&totals));
     let first_user_violation = rows
         .iter()
         .flat_map(|r| r.iterations.iter().map(move |i| (r, i)))
@@ -103,6 +112,44 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
             row.spec.label()
         );
     }
+}
+
+/// Lane changes with a collision or an RSS violation, over every experiment and
+/// method, in the steps the system drove and in those the user drove.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+struct Totals {
+    system_collisions: usize,
+    system_violations: usize,
+    user_collisions: usize,
+    user_violations: usize,
+}
+
+impl Totals {
+    fn add(&mut self, other: &Totals) {
+        self.system_collisions += other.system_collisions;
+        self.system_violations += other.system_violations;
+        self.user_collisions += other.user_collisions;
+        self.user_violations += other.user_violations;
+    }
+}
+
+/// The sentence that sets the totals against the target of no collision and no
+/// RSS violation in any executed lane change, system- or user-driven.
+fn verdict(t: &Totals) -> String {
+    let met = *t == Totals::default();
+    let mut sentence = "Target: no collision and no RSS violation in any executed lane change of \
+                        any experiment, system- or user-driven: "
+        .to_owned();
+    if met {
+        sentence.push_str("met.");
+    } else {
+        sentence.push_str(&format!(
+            "**not met** (lane changes with a collision: {} system-driven, {} user-driven; with \
+             an RSS violation: {} system-driven, {} user-driven).",
+            t.system_collisions, t.user_collisions, t.system_violations, t.user_violations
+        ));
+    }
+    sentence
 }
 
 /// `p5 / min` of `values` (nearest-rank percentile) with one decimal, `-` when
@@ -125,5 +172,20 @@ mod tests {
         let values: Vec<f64> = (0..=100).map(f64::from).rev().collect();
         assert_eq!(low_tail(values), "5.0 / 0.0");
         assert_eq!(low_tail(vec![3.25]), "3.2 / 3.2");
+    }
+
+    #[test]
+    fn the_target_is_met_only_without_any_collision_or_violation() {
+        assert!(verdict(&Totals::default()).ends_with(": met."));
+        let one_user_violation = Totals {
+            user_violations: 1,
+            ..Totals::default()
+        };
+        let text = verdict(&one_user_violation);
+        assert!(text.contains("**not met**"), "{text}");
+        assert!(
+            text.contains("RSS violation: 0 system-driven, 1 user-driven"),
+            "{text}"
+        );
     }
 }
