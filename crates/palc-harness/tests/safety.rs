@@ -434,10 +434,12 @@ proptest::proptest! {
         } else {
             include_str!("../../../configs/learn-safe.toml")
         };
-        let speed_case = ["collector-high", "collector-slow", "arterial-high", "arterial-slow"][case];
-        let config = LearnConfig::from_toml_str(text)
-            .expect("the config parses")
-            .with_cell(CellChoice { speed_case: speed_case.into(), headway_m, seed })
+        let base = LearnConfig::from_toml_str(text).expect("the config parses");
+        // The test bed's own speed cases (four in both configs).
+        let cases = &base.traffic.testbed.as_ref().expect("a test bed").speed_cases;
+        let speed_case = cases[case % cases.len()].name.clone();
+        let config = base
+            .with_cell(CellChoice { speed_case, headway_m, seed })
             .with_user(UserConfig::preset(StylePreset::ALL[style]));
         proptest::prop_assert!(config.planning.safety.users_wait_for_safe_gaps);
         // A scene with no safe lane change within the window is refused, not run.
