@@ -85,16 +85,21 @@ pub(crate) struct Dynamics {
     pub sparse: StepDynamics,
 }
 
+/// The index of an absent variable in an [`Inequality`].
+const ABSENT: u32 = u32::MAX;
+
 /// One inequality row `coef · ux[core] + slack_coef · σ[slack] <= h`.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Inequality {
-    /// `(stage, local index in [X; U])` of the stage variable, if any, packed
-    /// (16 bytes with the slack's index instead of 40: the interior point reads every
-    /// row several times per iteration).
-    core: Option<(u32, u32)>,
+    /// Index of the stage variable in the stage variables flattened
+    /// (`NZ * stage + local`, [`flat`]), or [`ABSENT`]: the interior point reads every
+    /// row several times per iteration, and a flat index costs one load where
+    /// `Option<(stage, local)>` cost two bounds checks and a branch (32 bytes a row
+    /// instead of 48).
+    var: u32,
+    /// Index of the slack variable, or [`ABSENT`].
+    slack: u32,
     pub coef: f64,
-    /// Index of the slack variable, if any.
-    slack: Option<u32>,
     pub slack_coef: f64,
     pub h: f64,
 }
@@ -109,9 +114,9 @@ impl Inequality {
         h: f64,
     ) -> Self {
         Self {
-            core: core.map(|(i, l)| (i as u32, l as u32)),
+            var: core.map_or(ABSENT, |(i, l)| (NZ * i + l) as u32),
             coef,
-            slack: slack.map(|k| k as u32),
+            slack: slack.map_or(ABSENT, |k| k as u32),
             slack_coef,
             h,
         }
@@ -120,21 +125,58 @@ impl Inequality {
     /// `(stage, local index in [X; U])` of the stage variable, if any.
     #[inline(always)]
     pub fn core(&self) -> Option<(usize, usize)> {
-        self.core.map(|(i, l)| (i as usize, l as usize))
+        self.var().map(|v| (v / NZ, v % NZ))
+    }
+
+    /// Index of the stage variable in the flattened stage variables ([`flat`]), if any.
+    #[inline(always)]
+    pub fn var(&self) -> Option<usize> {
+        (self.var != ABSENT).then_some(self.var as usize)
     }
 
     /// Index of the slack variable, if any.
     #[inline(always)]
     pub fn slack(&self) -> Option<usize> {
-        self.slack.map(|k| k as usize)
+        (self.slack != ABSENT).then_some(self.slack as usize)
     }
 
-    /// `(G x)_j` of this row for the stage variables `ux` and the slacks `σ`.
+    /// The entry of the row's stage variable in `ux` (flattened, [`flat`]), if any.
     #[inline(always)]
-    pub fn times(&self, ux: &[Vector6<f64>], sigma: &[f64]) -> f64 {
-        self.core().map_or(0.0, |(i, l)| self.coef * ux[i][l])
-            + self.slack().map_or(0.0, |k| self.slack_coef * sigma[k])
+    pub fn var_in<'a>(&self, ux: &'a mut [f64]) -> Option<&'a mut f64> {
+        // `ABSENT` is past the end of any slice: one comparison says both that the
+        // variable exists and that its index is in bounds.
+        ux.get_mut(self.var as usize)
     }
+
+    /// The entry of the row's slack in `sigma`, if any.
+    #[inline(always)]
+    pub fn slack_in<'a>(&self, sigma: &'a mut [f64]) -> Option<&'a mut f64> {
+        sigma.get_mut(self.slack as usize)
+    }
+
+    /// `(G x)_j` of this row for the stage variables `ux` (flattened, [`flat`]) and
+    /// the slacks `σ`.
+    #[inline(always)]
+    pub fn times(&self, ux: &[f64], sigma: &[f64]) -> f64 {
+        // As in `var_in`: one comparison for presence and bounds.
+        ux.get(self.var as usize).map_or(0.0, |x| self.coef * x)
+            + sigma
+                .get(self.slack as usize)
+                .map_or(0.0, |x| self.slack_coef * x)
+    }
+}
+
+/// The stage variables `[X_0; U_0], ..., [X_K; U_K]` as one slice, `NZ` entries a
+/// stage: the layout the rows' indices ([`Inequality::var`]) refer to.
+#[inline(always)]
+pub(crate) fn flat(ux: &[Vector6<f64>]) -> &[f64] {
+    bytemuck::cast_slice(ux)
+}
+
+/// [`flat`], mutable.
+#[inline(always)]
+pub(crate) fn flat_mut(ux: &mut [Vector6<f64>]) -> &mut [f64] {
+    bytemuck::cast_slice_mut(ux)
 }
 
 /// The QP of one plan in stage form; buffers reused between plans.

@@ -23,7 +23,7 @@ use super::head;
 use super::residuals::Residuals;
 use super::step::dual_step;
 use super::variables::{Direction, Variables, resize_keep};
-use crate::qp::{StageQp, hessian_mul};
+use crate::qp::{StageQp, flat, flat_mut, hessian_mul};
 
 /// The Newton system's data, its factorization and its solve buffers.
 #[derive(Debug, Default)]
@@ -57,12 +57,13 @@ pub(crate) struct Kkt {
 
 /// `out += Gᵀ v`, split into stage variables and slacks.
 fn add_g_transpose(qp: &StageQp, v: &[f64], out: &mut [Vector6<f64>], out_sigma: &mut [f64]) {
+    let out = flat_mut(out);
     for (row, &v) in qp.inequalities.iter().zip(v) {
-        if let Some((i, l)) = row.core() {
-            out[i][l] += row.coef * v;
+        if let Some(x) = row.var_in(out) {
+            *x += row.coef * v;
         }
-        if let Some(j) = row.slack() {
-            out_sigma[j] += row.slack_coef * v;
+        if let Some(x) = row.slack_in(out_sigma) {
+            *x += row.slack_coef * v;
         }
     }
 }
@@ -135,9 +136,12 @@ impl Kkt {
     /// Σ_R W c_σ²`, which is what is added.
     pub fn factor(&mut self, qp: &StageQp) -> Result<(), FactorError> {
         self.newton_diag.fill(Vector6::zeros());
+        let diag = flat_mut(&mut self.newton_diag);
         for (row, &w) in qp.inequalities.iter().zip(&self.w) {
-            if let (Some((i, l)), None) = (row.core(), row.slack()) {
-                self.newton_diag[i][l] += w * row.coef * row.coef;
+            if row.slack().is_none() {
+                if let Some(x) = row.var_in(diag) {
+                    *x += w * row.coef * row.coef;
+                }
             }
         }
         for (j, rows) in qp.slack_rows.iter().enumerate() {
@@ -226,8 +230,9 @@ impl Kkt {
         );
         let (ds, d_lambda) = (&mut d.s[..n], &mut d.lambda[..n]);
         let mut alpha = 1.0_f64;
+        let d_ux = flat(&d.ux);
         for j in 0..n {
-            let step_s = -r_in[j] - rows[j].times(&d.ux, &d.sigma);
+            let step_s = -r_in[j] - rows[j].times(d_ux, &d.sigma);
             ds[j] = step_s;
             d_lambda[j] = dual_step(s[j], lambda[j], rc[j], inv_s[j], step_s, &mut alpha);
         }
@@ -295,8 +300,9 @@ impl Kkt {
         for (d_sigma, correction) in d.sigma.iter_mut().zip(&c.sigma) {
             *d_sigma += correction;
         }
+        let c_ux = flat(&c.ux);
         for (ds, row) in d.s.iter_mut().zip(&qp.inequalities) {
-            *ds -= row.times(&c.ux, &c.sigma);
+            *ds -= row.times(c_ux, &c.sigma);
         }
     }
 

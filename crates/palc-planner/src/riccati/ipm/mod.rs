@@ -183,7 +183,7 @@ impl Ipm {
         } = self;
         // The Newton system at x = 0.
         v.zero();
-        residuals.compute(qp, v);
+        residuals.compute_at_origin(qp);
         kkt.w.fill(1.0);
         kkt.factor(qp)?;
         for (xi, row) in kkt.xi.iter_mut().zip(&qp.inequalities) {

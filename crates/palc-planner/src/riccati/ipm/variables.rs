@@ -16,6 +16,8 @@
 
 use nalgebra::{Vector4, Vector6};
 
+use crate::qp::{flat, flat_mut};
+
 /// One primal-dual iterate `(x, s, y, λ)`.
 #[derive(Debug, Default, Clone)]
 pub(crate) struct Variables {
@@ -79,20 +81,23 @@ impl Variables {
 
     /// `(x, s, λ) += α (Δx, Δs, Δλ)` and `y += α (y⁺ - y)`.
     pub fn take_step(&mut self, d: &Direction, alpha: f64) {
-        for (x, dx) in self.ux.iter_mut().zip(&d.ux) {
-            *x += alpha * dx;
-        }
-        for (x, dx) in self.sigma.iter_mut().zip(&d.sigma) {
-            *x += alpha * dx;
-        }
-        for (x, dx) in self.s.iter_mut().zip(&d.s) {
-            *x += alpha * dx;
-        }
-        for (x, dx) in self.lambda.iter_mut().zip(&d.lambda) {
-            *x += alpha * dx;
-        }
+        // On the flattened entries: one loop the compiler vectorizes instead of one
+        // small-vector operation per stage (a third of this step's instructions).
+        let axpy = |x: &mut [f64], dx: &[f64]| {
+            for (x, dx) in x.iter_mut().zip(dx) {
+                *x += alpha * dx;
+            }
+        };
+        axpy(flat_mut(&mut self.ux), flat(&d.ux));
+        axpy(&mut self.sigma, &d.sigma);
+        axpy(&mut self.s, &d.s);
+        axpy(&mut self.lambda, &d.lambda);
         self.y_initial += alpha * (d.y_initial - self.y_initial);
-        for (y, y_new) in self.y_dynamics.iter_mut().zip(&d.y_dynamics) {
+        let y_new: &[f64] = bytemuck::cast_slice(&d.y_dynamics);
+        for (y, y_new) in bytemuck::cast_slice_mut::<_, f64>(&mut self.y_dynamics)
+            .iter_mut()
+            .zip(y_new)
+        {
             *y += alpha * (y_new - *y);
         }
         self.y_terminal += alpha * (d.y_terminal - self.y_terminal);

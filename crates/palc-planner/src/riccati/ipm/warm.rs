@@ -24,7 +24,7 @@ use nalgebra::Vector6;
 
 use super::super::params::WARM_GAP;
 use super::Ipm;
-use crate::qp::{Inequality, NX, StageQp};
+use crate::qp::{Inequality, NX, StageQp, flat};
 
 /// Kinds of inequality rows told apart when shifting: `(local index, sign, kind)`,
 /// kind 0 a row on a stage variable only, 1 a row with its soft-bound slack, 2 a row on
@@ -117,7 +117,7 @@ impl Ipm {
         let mu = WARM_GAP * (1.0 + objective.abs()) / m_in as f64;
         let floor = mu.sqrt();
         for (j, row) in qp.inequalities.iter().enumerate() {
-            let mut s = (row.h - row.times(&w.ux, &w.sigma)).max(0.0);
+            let mut s = (row.h - row.times(flat(&w.ux), &w.sigma)).max(0.0);
             let mut l = w.lambda[j].max(0.0);
             if s >= l {
                 s = s.max(floor);
