@@ -451,6 +451,40 @@ mod tests {
     use proptest::prelude::*;
 
     proptest! {
+        /// A row's flat index names the stage variable it was built with, and its
+        /// product `(G x)_j` on the flattened stage variables equals the product on
+        /// the stage vectors, with and without a variable or a slack.
+        #[test]
+        fn a_row_reads_its_variable_through_the_flat_index(
+            stage in 0..40usize,
+            local in 0..NZ,
+            has_var in any::<bool>(),
+            slack in prop::option::of(0..5usize),
+            coef in -10.0..10.0f64,
+            slack_coef in -10.0..10.0f64,
+            values in prop::collection::vec(-100.0..100.0f64, 40 * NZ),
+            sigma in prop::collection::vec(-100.0..100.0f64, 5),
+        ) {
+            let core = has_var.then_some((stage, local));
+            let row = Inequality::new(core, coef, slack, slack_coef, 1.0);
+            prop_assert_eq!(row.core(), core);
+            prop_assert_eq!(row.slack(), slack);
+            let ux: Vec<Vector6<f64>> =
+                values.chunks(NZ).map(Vector6::from_column_slice).collect();
+            let expected = core.map_or(0.0, |(i, l)| coef * ux[i][l])
+                + slack.map_or(0.0, |k| slack_coef * sigma[k]);
+            prop_assert_eq!(row.times(flat(&ux), &sigma), expected);
+            let mut flat_ux = values.clone();
+            match row.var_in(&mut flat_ux) {
+                Some(x) => {
+                    prop_assert!(has_var);
+                    *x += 1.0;
+                    prop_assert_eq!(flat_ux[NZ * stage + local], values[NZ * stage + local] + 1.0);
+                }
+                None => prop_assert!(!has_var),
+            }
+        }
+
         /// Every assembled cost block is zero outside the pattern [`hessian_mul`] reads,
         /// and the product equals the dense one.
         #[test]
