@@ -233,3 +233,82 @@ fn max(a: f64, b: f64) -> f64 {
 fn amax<const R: usize>(v: &SVector<f64, R>) -> f64 {
     v.iter().fold(0.0, |m, x| max(m, x.abs()))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::qp::flat;
+    use crate::{
+        LateralBound, LateralBoundsMode, PlannerConfig, Position, Problem, State, Terminal, Weights,
+    };
+
+    /// Mehrotra's start reads the same residuals from the pass at the origin as from
+    /// the full pass at a zero iterate, bit for bit (signs of zero included), with hard
+    /// and soft bounds.
+    #[test]
+    fn the_residuals_at_the_origin_are_those_of_the_full_pass_at_zero() {
+        for mode in [
+            LateralBoundsMode::Hard,
+            LateralBoundsMode::Soft { weight: 100.0 },
+        ] {
+            let config = PlannerConfig {
+                horizon: 12,
+                lateral_bounds_mode: mode,
+                ..PlannerConfig::default()
+            };
+            let k = config.horizon;
+            let speed = 20.0;
+            let problem = Problem {
+                initial: State {
+                    s: 100.0,
+                    v: speed,
+                    l: 0.4,
+                    phi: 0.01,
+                },
+                reference_speed: vec![speed; k],
+                curvature: 0.001,
+                weights: Weights::constant(
+                    k,
+                    [0.1, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 10.0, 1e-3, 1e-3],
+                ),
+                preceding: vec![Position { s: 130.0, l: 0.0 }; k],
+                adjacent: vec![Position { s: 90.0, l: 3.5 }; k],
+                terminal: Terminal {
+                    s: None,
+                    v: speed,
+                    l: 3.5,
+                },
+                lateral_bounds: vec![Some(LateralBound::new(-1.75, 5.25)); k + 1],
+                tracking: None,
+            };
+            let mut qp = StageQp::default();
+            qp.assemble(&config, &problem);
+            let mut v = Variables::default();
+            v.resize(k, qp.slack_cost.len(), qp.inequalities.len());
+            v.zero();
+            let (mut full, mut origin) = (Residuals::default(), Residuals::default());
+            full.reset(&qp);
+            origin.reset(&qp);
+            full.compute(&qp, &v);
+            origin.compute_at_origin(&qp);
+            let bits = |x: &[f64]| x.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            let offsets = |r: &Residuals| {
+                r.offsets
+                    .iter()
+                    .flat_map(|o| bits(o.as_slice()))
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(bits(flat(&full.grad)), bits(flat(&origin.grad)), "{mode:?}");
+            assert_eq!(bits(&full.inequality), bits(&origin.inequality), "{mode:?}");
+            assert_eq!(offsets(&full), offsets(&origin), "{mode:?}");
+            assert_eq!(
+                bits(full.initial.as_slice()),
+                bits(origin.initial.as_slice())
+            );
+            assert_eq!(
+                bits(full.terminal.as_slice()),
+                bits(origin.terminal.as_slice())
+            );
+        }
+    }
+}
