@@ -125,13 +125,8 @@ impl Inequality {
     /// `(stage, local index in [X; U])` of the stage variable, if any.
     #[inline(always)]
     pub fn core(&self) -> Option<(usize, usize)> {
-        self.var().map(|v| (v / NZ, v % NZ))
-    }
-
-    /// Index of the stage variable in the flattened stage variables ([`flat`]), if any.
-    #[inline(always)]
-    pub fn var(&self) -> Option<usize> {
-        (self.var != ABSENT).then_some(self.var as usize)
+        let var = self.var as usize;
+        (self.var != ABSENT).then_some((var / NZ, var % NZ))
     }
 
     /// Index of the slack variable, if any.
@@ -167,7 +162,7 @@ impl Inequality {
 }
 
 /// The stage variables `[X_0; U_0], ..., [X_K; U_K]` as one slice, `NZ` entries a
-/// stage: the layout the rows' indices ([`Inequality::var`]) refer to.
+/// stage: the layout the rows' variable indices refer to.
 #[inline(always)]
 pub(crate) fn flat(ux: &[Vector6<f64>]) -> &[f64] {
     bytemuck::cast_slice(ux)

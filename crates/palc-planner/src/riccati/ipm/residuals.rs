@@ -237,7 +237,6 @@ fn amax<const R: usize>(v: &SVector<f64, R>) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::qp::flat;
     use crate::{
         LateralBound, LateralBoundsMode, PlannerConfig, Position, Problem, State, Terminal, Weights,
     };
