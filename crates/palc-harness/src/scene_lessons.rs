@@ -94,7 +94,7 @@ mod tests {
             start_s,
             duration_s,
             target_l: 3.5,
-            shape: crate::onset::Shape::Quintic,
+            shape: crate::onset::Shape::QUINTIC,
         };
         let path = (0..120).map(|i| user.lateral(i as f64 * DT)).collect();
         (user, path)
