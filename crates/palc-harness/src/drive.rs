@@ -129,15 +129,7 @@ pub fn execute(
         p.map_or([1e4, 0.0], |v| [v.state.s - setup.origin_s, v.state.l])
     };
     let mut user_speed_differs = false;
-    let driving = UserDriving {
-        setup,
-        user,
-        expectation,
-        expected_l: &expected_l,
-        seeking_until: (expectation.lane_change.end_s() / dt - 1e-9)
-            .ceil()
-            .max(0.0) as usize,
-    };
+    let driving = UserDriving::new(setup, user, expectation, &expected_l);
     // Where the system had driven the ego when the user took over: the plan's
     // state there, unless the longitudinal guard held the ego back.
     let mut at_takeover = plan.states[0];
@@ -248,7 +240,25 @@ struct UserDriving<'a> {
     seeking_until: usize,
 }
 
-impl UserDriving<'_> {
+impl<'a> UserDriving<'a> {
+    /// `user` driving `expectation` (its lateral positions `expected_l`).
+    fn new(
+        setup: &'a Setup,
+        user: &'a dyn User,
+        expectation: &'a Expectation,
+        expected_l: &'a [f64],
+    ) -> Self {
+        UserDriving {
+            setup,
+            user,
+            expectation,
+            expected_l,
+            seeking_until: (expectation.lane_change.end_s() / setup.dt - 1e-9)
+                .ceil()
+                .max(0.0) as usize,
+        }
+    }
+
     /// The user's state at step `i` after `previous`, its lateral path `held` steps
     /// late, and whether its acceleration differs from the ego ACC's.
     ///
@@ -286,9 +296,8 @@ impl UserDriving<'_> {
     /// Whether the user, at `previous` in `scene`, holds its lateral position
     /// instead of moving to `next` (step `i`, its path `held` steps late): the move
     /// would bring the ego's footprint into the target lane at a gap it does not
-    /// enter. Every user holds beside a target-lane vehicle (their lengths
-    /// overlapping one step ahead, a gap of zero or less): a driver does not steer
-    /// into a vehicle beside it. A user who waits for safe gaps
+    /// enter. Every user holds beside a target-lane vehicle
+    /// ([`UserDriving::enters_beside`]). A user who waits for safe gaps
     /// (`planning.safety.users_wait_for_safe_gaps`) also holds when its lane change
     /// from here, driven on a clone of the scene to the horizon's end, would bring
     /// the target lane's lead or lag vehicle below the RSS safe distance while the
@@ -306,30 +315,19 @@ impl UserDriving<'_> {
         held: usize,
     ) -> Result<bool, HarnessError> {
         let setup = self.setup;
-        let Some(ego) = scene.ego() else {
+        let Some(mut ahead) = entering(setup, scene, previous, next)? else {
             return Ok(false);
         };
-        let road = scene.road();
-        let lane = road.nearest_lane(setup.target_l);
-        let width = ego.width;
-        if next.l <= previous.l
-            || road.occupies(previous.l, width, lane)
-            || !road.occupies(next.l, width, lane)
-        {
-            return Ok(false);
-        }
-        let mut ahead = scene.clone();
-        ahead.step(setup.dt, ego_state(setup, next))?;
-        let seen = situation(&ahead);
-        let beside = seen.target_lead_gap_m.is_some_and(|g| g <= 0.0)
-            || seen.target_lag_gap_m.is_some_and(|g| g <= 0.0);
-        if beside {
+        if beside(&ahead) {
             return Ok(true);
         }
         let safety = &setup.safety;
         if !safety.users_wait_for_safe_gaps {
             return Ok(false);
         }
+        let road = scene.road();
+        let lane = road.nearest_lane(setup.target_l);
+        let width = scene.ego().map_or(0.0, |ego| ego.width);
         let mut state = *next;
         for j in i..=setup.horizon {
             if j > i {
@@ -343,6 +341,72 @@ impl UserDriving<'_> {
         }
         Ok(false)
     }
+}
+
+/// The scene one step after `scene` with the ego moved to `next`, when that move
+/// brings the ego's footprint into the target lane (from `previous`, outside it);
+/// `None` for any other move.
+fn entering(
+    setup: &Setup,
+    scene: &Scene,
+    previous: &State,
+    next: &State,
+) -> Result<Option<Scene>, HarnessError> {
+    let Some(ego) = scene.ego() else {
+        return Ok(None);
+    };
+    let road = scene.road();
+    let lane = road.nearest_lane(setup.target_l);
+    if next.l <= previous.l
+        || road.occupies(previous.l, ego.width, lane)
+        || !road.occupies(next.l, ego.width, lane)
+    {
+        return Ok(None);
+    }
+    let mut ahead = scene.clone();
+    ahead.step(setup.dt, ego_state(setup, next))?;
+    Ok(Some(ahead))
+}
+
+/// Whether a target-lane vehicle is beside the ego in `scene`: their lengths
+/// overlap (a gap of zero or less). A driver does not steer into a vehicle
+/// beside it.
+fn beside(scene: &Scene) -> bool {
+    let seen = situation(scene);
+    seen.target_lead_gap_m.is_some_and(|g| g <= 0.0)
+        || seen.target_lag_gap_m.is_some_and(|g| g <= 0.0)
+}
+
+/// The first step at which `user`, driving its own expected lane change
+/// `expectation` from the trigger (as it drives after a takeover), would enter
+/// the target lane beside a vehicle of it, the move it never makes
+/// ([`UserDriving::holds_before_entering`]); `None` when its lane change never
+/// does. A user whose expectation does is inconsistent in the scene: it takes
+/// over any plan that differs from that expectation and then drives something
+/// else (it holds), which is what it teaches, and the plan copying the hold is
+/// taken over again.
+pub(crate) fn own_lane_change_enters_beside(
+    setup: &Setup,
+    user: &dyn User,
+    expectation: &Expectation,
+) -> Result<Option<usize>, HarnessError> {
+    let k = setup.horizon;
+    let expected_l = expectation.lateral(k);
+    let driving = UserDriving::new(setup, user, expectation, &expected_l);
+    let mut scene = setup.scene.clone();
+    let mut previous = State {
+        l: expected_l[0],
+        ..expectation.states[0]
+    };
+    for i in 1..=k {
+        let (next, _) = driving.step(&scene, &previous, i, 0);
+        if entering(setup, &scene, &previous, &next)?.is_some_and(|ahead| beside(&ahead)) {
+            return Ok(Some(i));
+        }
+        scene.step(setup.dt, ego_state(setup, &next))?;
+        previous = next;
+    }
+    Ok(None)
 }
 
 /// The safety of `plan` driven to its end in a clone of the scene, with the other

@@ -16,7 +16,9 @@ use crate::HarnessError;
 use crate::carry::{rehearse, starting_experience};
 use crate::closed_loop::ClosedLoop;
 use crate::config::{LearnConfig, StoppingConfig};
-use crate::drive::{Drive, execute, judge, plan_safety, problem, states_safety};
+use crate::drive::{
+    Drive, execute, judge, own_lane_change_enters_beside, plan_safety, problem, states_safety,
+};
 use crate::learn::{RunResult, aggregator_options, prepare_for};
 use crate::lesson::{lesson, scenes, zone_feature_set};
 use crate::method::Method;
@@ -142,6 +144,18 @@ impl LearningLoop {
                     ),
                 });
             }
+        }
+        // The user's own lane change, driven by the user, must not enter the
+        // target lane beside a vehicle of it: the user would hold there, so it
+        // would take over any other plan and then teach a hold it does not expect.
+        if let Some(step) = own_lane_change_enters_beside(&setup, user.as_ref(), &nominal)? {
+            return Err(HarnessError::Scenario {
+                scenario: config.label(),
+                reason: format!(
+                    "user `{}` would hold its own lane change beside a target-lane vehicle at step {step}",
+                    user.name()
+                ),
+            });
         }
         let options = aggregator_options(config);
         options.validate()?;

@@ -153,13 +153,14 @@ proptest::proptest! {
 }
 
 /// collector-high / 30 m / seed 4 (a seed no figure uses), a cautious user who
-/// starts on a time to collision of 8 s: the first plan slows the ego behind the
-/// preceding vehicle earlier than the lane-keeping prediction on which the user
-/// chose its start, so that when the user takes over, after that start, the
-/// target lane's follower is alongside. The user holds its lateral position
-/// instead of steering into it (it collided before).
+/// starts on a time to collision of 8 s: its own lane change, driven from its
+/// start at the lane-keeping speeds, enters the target lane while the follower
+/// is alongside. Driving, the user holds its lateral position instead of steering
+/// into it; its expectation does not, so it would take over every plan that
+/// differs from that expectation and teach a hold it does not expect (the run
+/// reached the cap). The loop refuses the scene for this user.
 #[test]
-fn a_user_who_takes_over_beside_the_follower_does_not_steer_into_it() {
+fn a_user_holds_beside_the_follower_and_a_scene_where_its_own_lane_change_would_is_refused() {
     let text = include_str!("../../../configs/learn.toml");
     let user = UserConfig::from_toml_str(
         "[user]\nstyle = \"cautious\"\nfamily = { start = { rule = \"time-to-collision\", seconds = 8.0 } }\n",
@@ -175,17 +176,48 @@ fn a_user_who_takes_over_beside_the_follower_does_not_steer_into_it() {
             seed: 4,
         })
         .with_user(user);
-    let mut lane_changes =
-        palc_harness::LearningLoop::new(&config, None).expect("the scene prepares");
-    let record = lane_changes
-        .step(&mut NoObserver)
-        .expect("the lane change runs")
-        .clone();
-    let takeover = record.takeover.as_ref().expect("the user takes over");
-    assert!(!record.user_safety.collision, "{:?}", record.user_safety);
+    let Err(error) = palc_harness::LearningLoop::new(&config, None) else {
+        panic!("the scene is refused");
+    };
+    let message = error.to_string();
+    assert!(
+        message.contains("collector-high / 30 m / seed 4"),
+        "{message}"
+    );
+    assert!(
+        message.contains("would hold its own lane change beside a target-lane vehicle"),
+        "{message}"
+    );
+    // The user, taking over a plan that keeps the lane at the lane-keeping speeds
+    // of its own lane change, holds rather than steer into the follower.
+    let (setup, nominal) = palc_harness::expectation(&config).expect("the scene prepares");
+    let user = (config.user)
+        .simulated(config.planning.takeover_threshold_m)
+        .expect("the user builds");
+    // A plan of the scene whose states are then replaced by the lane kept at
+    // the user's own speeds.
+    let keep_lane = palc_harness::advanced::problem(
+        &setup,
+        palc_planner::Weights::constant(setup.horizon, [0.0; 10]),
+        Vec::new(),
+    );
+    let mut plan = palc_planner::Planner::new(palc_planner::PlannerConfig {
+        horizon: setup.horizon,
+        dt: setup.dt,
+        ..palc_planner::PlannerConfig::default()
+    })
+    .expect("a planner")
+    .plan(&keep_lane)
+    .expect("a plan");
+    for (state, own) in plan.states.iter_mut().zip(&nominal.states) {
+        *state = palc_planner::State { l: 0.0, ..*own };
+    }
+    let drive = palc_harness::advanced::execute(&setup, plan, &user, &nominal).expect("it drives");
+    let takeover = drive.takeover.as_ref().expect("the user takes over");
+    assert!(!drive.user_safety.collision, "{:?}", drive.user_safety);
     // It held: the driven path stays below the expected one after the takeover.
-    let behind = (takeover.step..record.driven_l.len())
-        .filter(|&i| record.driven_l[i] < record.expected_l[i] - 0.1)
+    let behind = (takeover.step..drive.driven.len())
+        .filter(|&i| drive.driven[i].l < drive.expected_l[i] - 0.1)
         .count();
     assert!(behind > 0, "the user never held its lateral position");
 }
