@@ -88,6 +88,32 @@ fn a_carried_experience_starts_where_the_new_scene_puts_the_user() {
 }
 
 #[test]
+fn a_carried_experience_starts_where_the_new_scene_puts_a_user_whose_lateral_speed_peaks_off_centre()
+ {
+    // The start seen in the lesson is extrapolated with a lane-change model; a
+    // symmetric model misplaces the start of a user whose lateral speed peaks
+    // early or late, and the error doubles when the closing speed halves. (The
+    // aggressive user's 1.7 s lane change is too sharp with such a peak: its
+    // scenes are refused.)
+    for peak in [0.4, 0.7] {
+        for style in [StylePreset::Neutral, StylePreset::Cautious] {
+            let with_profile = |mut config: LearnConfig| {
+                config.user.family = Some(
+                    toml::from_str(&format!(
+                        r#"profile = {{ shape = "asymmetric", peak_fraction = {peak} }}"#
+                    ))
+                    .expect("a family table"),
+                );
+                config
+            };
+            let experience = learned_in(&with_profile(config("collector-slow", 50.0, style)));
+            let target = with_profile(config("collector-high", 50.0, style));
+            assert_start_predicted_to_the_step(&target, &experience, style);
+        }
+    }
+}
+
+#[test]
 fn relative_onset_transfers_better_than_time_indexing() {
     let (mut relative_sum, mut time_indexed_sum) = (0, 0);
     for style in StylePreset::ALL {
