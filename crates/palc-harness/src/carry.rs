@@ -11,7 +11,7 @@ use palc_planner::{Planner, Problem, State};
 use crate::HarnessError;
 use crate::config::LearnConfig;
 use crate::lesson::scenes;
-use crate::onset::predicted_start_s;
+use crate::onset::{UserLaneChange, predicted_start_s};
 use crate::setup::Setup;
 
 /// The experience a run starts from: `previous` carried into this scenario, or a
@@ -49,8 +49,16 @@ pub(crate) fn starting_experience(
     carried.metadata.scenario = config.label();
     let anchored = match (options.representation, previous.anchor_s) {
         (Representation::RelativeOnset, Some(anchor)) => {
-            let latest = latest_planned_start_s(config, setup, previous, anchor);
-            predicted_start_s(setup, &previous.onsets).map(|start| (anchor, start.min(latest)))
+            let settled = settled_duration_s(config, previous, anchor);
+            let latest = latest_planned_start_s(setup, settled);
+            // The lane change whose gaps the prediction checks: the model fitted to
+            // the demonstration (a quintic settles within 1 % at 88 % of its
+            // duration, and a user who checks its whole lane change waits longer).
+            let lane_change = (previous.demonstration.as_deref())
+                .and_then(|path| UserLaneChange::fit(path, 0, previous.metadata.dt, setup.target_l))
+                .map_or(settled, |fitted| fitted.duration_s.max(settled));
+            (predicted_start_s(setup, &previous.onsets, lane_change))
+                .map(|start| (anchor, start.min(latest)))
         }
         _ => None,
     };
@@ -71,9 +79,8 @@ pub(crate) fn starting_experience(
 }
 
 /// The latest start (s) a carried lane change is anchored at: the one whose lane
-/// change, as long as the carried one (its demonstration from `anchor_s` until it
-/// settles within 1 % of its end; the standard ALC's duration without one), ends
-/// within the planning horizon. Never before the standard ALC's start.
+/// change, `duration_s` long ([`settled_duration_s`]), ends within the planning
+/// horizon. Never before the standard ALC's start.
 ///
 /// Users whose family waits for a follower's gap start after the standard ALC (the
 /// premise that no user does holds for the paper's three styles only); holding
@@ -82,21 +89,21 @@ pub(crate) fn starting_experience(
 /// change plus the margin; a prediction held at its end is then still later than
 /// the user's start by the margin, so the bound never turns a late prediction
 /// into a right one.
-fn latest_planned_start_s(
-    config: &LearnConfig,
-    setup: &Setup,
-    previous: &Experience,
-    anchor_s: f64,
-) -> f64 {
+fn latest_planned_start_s(setup: &Setup, duration_s: f64) -> f64 {
     let standard_start = setup.standard_start_step as f64 * setup.dt;
-    // A demonstration that settles before its own start (none learned yet) says
-    // nothing: the standard ALC's duration, the longest, is assumed instead.
-    let duration = (previous.demonstration.as_deref())
+    (setup.horizon as f64 * setup.dt - duration_s).max(standard_start)
+}
+
+/// The duration (s) of the carried lane change: its demonstration from `anchor_s`
+/// until it settles within 1 % of its end. A demonstration that settles before
+/// its own start (none learned yet) says nothing: the standard ALC's duration, the
+/// longest, is assumed instead.
+fn settled_duration_s(config: &LearnConfig, previous: &Experience, anchor_s: f64) -> f64 {
+    (previous.demonstration.as_deref())
         .and_then(|path| settled_s(path, previous.metadata.dt))
         .map(|end| end - anchor_s)
         .filter(|&duration| duration > 0.0)
-        .unwrap_or(config.planning.standard_alc.lane_change_duration_s);
-    (setup.horizon as f64 * setup.dt - duration).max(standard_start)
+        .unwrap_or(config.planning.standard_alc.lane_change_duration_s)
 }
 
 /// The first time (s) from which `path` (step `dt`) stays within 1 % of its last

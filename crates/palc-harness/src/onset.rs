@@ -645,9 +645,12 @@ fn acceptance(onsets: &[Onset], gap: fn(&Onset) -> Option<f64>) -> f64 {
 /// its threshold, then the first step from there at which the target-lane gaps
 /// are at least the learned ones (for the leader, also above every lead gap the
 /// user refused after deciding, and at least the standard ALC's lead gap or the
-/// smallest one the user accepted, whichever is smaller). `None` without onsets,
-/// or when the prediction does not start within the search window.
-pub(crate) fn predicted_start_s(setup: &Setup, onsets: &[Onset]) -> Option<f64> {
+/// smallest one the user accepted, whichever is smaller). Under the safety layer
+/// the gaps are also at the safe distance at every step of the carried lane
+/// change (`duration_s` from the start, on the lane-keeping prediction): a start
+/// whose lane change the layer would refuse is not predicted. `None` without
+/// onsets, or when the prediction does not start within the search window.
+pub(crate) fn predicted_start_s(setup: &Setup, onsets: &[Onset], duration_s: f64) -> Option<f64> {
     if onsets.is_empty() {
         return None;
     }
@@ -673,14 +676,23 @@ pub(crate) fn predicted_start_s(setup: &Setup, onsets: &[Onset]) -> Option<f64> 
     let decides = |s: &Situation| {
         s.time_headway_s > 0.0 && feature.of_situation(s).is_some_and(|x| x <= threshold)
     };
-    // Under the safety layer a start below the safe distance would be refused.
-    let accepts = |s: &Situation| {
+    // Under the safety layer a lane change below the safe distance would be
+    // refused.
+    let steps = (duration_s / setup.dt).ceil().max(0.0) as usize;
+    let safe_through = |i: usize| {
+        let end = i.saturating_add(steps).min(situations.len() - 1);
+        situations[i..=end]
+            .iter()
+            .all(|s| target_gaps_safe(s, safety))
+    };
+    let accepts = |i: usize| {
+        let s = &situations[i];
         lead_time_gap(s).is_none_or(|g| g > 0.0 && g >= lead)
             && lag_time_gap(s).is_none_or(|g| g > 0.0 && g >= lag)
-            && (!safety.enforce || target_gaps_safe(s, safety))
+            && (!safety.enforce || safe_through(i))
     };
     let decided = situations.iter().position(decides)?;
-    let start = decided + situations[decided..].iter().position(accepts)?;
+    let start = (decided..situations.len()).find(|&i| accepts(i))?;
     Some(start as f64 * setup.dt)
 }
 

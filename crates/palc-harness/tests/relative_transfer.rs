@@ -182,6 +182,31 @@ fn under_the_safety_layer_the_predicted_start_waits_for_a_safe_gap() {
     }
 }
 
+#[test]
+fn under_the_safety_layer_the_predicted_lane_change_is_safe_throughout() {
+    // collector-high / 35 m / seed 1: the target lane's gaps reach the safe
+    // distance before they stay there through a lane change; the users wait for
+    // the latter, and so does the prediction (one that checked the start's step
+    // alone started early, and every style took over).
+    let text = include_str!("../../../configs/learn-safe.toml");
+    let base = LearnConfig::from_toml_str(text).expect("the safe config parses");
+    let cell = |speed_case: &str, style| {
+        (base.clone())
+            .with_cell(CellChoice {
+                speed_case: speed_case.into(),
+                headway_m: 35.0,
+                seed: 1,
+            })
+            .with_user(UserConfig::preset(style))
+    };
+    for style in StylePreset::ALL {
+        let learned = run(&cell("collector-slow", style), None, &mut NoObserver)
+            .expect("the source run completes");
+        let target = cell("collector-high", style);
+        assert_start_predicted_to_the_step(&target, &learned.experience, style);
+    }
+}
+
 /// One user through `headways` of `speed_case` in order, each scene started from
 /// the experience of the one before; the experience after each scene.
 fn chain(
