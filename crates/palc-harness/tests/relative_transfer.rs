@@ -10,6 +10,18 @@ use palc_harness::{
 fn config(speed_case: &str, headway_m: f64, style: StylePreset) -> LearnConfig {
     let text = include_str!("../../../configs/learn.toml");
     let base = LearnConfig::from_toml_str(text).expect("the default config parses");
+    cell_of(base, speed_case, headway_m, style)
+}
+
+/// The same cell under the safe set-up (`configs/learn-safe.toml`: the ego's ACC, the
+/// safety layer, users who wait for the safe distance).
+fn safe_config(speed_case: &str, headway_m: f64, style: StylePreset) -> LearnConfig {
+    let text = include_str!("../../../configs/learn-safe.toml");
+    let base = LearnConfig::from_toml_str(text).expect("the safe config parses");
+    cell_of(base, speed_case, headway_m, style)
+}
+
+fn cell_of(base: LearnConfig, speed_case: &str, headway_m: f64, style: StylePreset) -> LearnConfig {
     base.with_cell(CellChoice {
         speed_case: speed_case.into(),
         headway_m,
@@ -149,22 +161,15 @@ fn under_the_safety_layer_the_predicted_start_waits_for_a_safe_gap() {
     // With the ACC and the safety layer (configs/learn-safe.toml), a start below the
     // safe distance would be refused, and the users wait for the safe distance too:
     // the prediction of a carried experience skips such steps.
-    let text = include_str!("../../../configs/learn-safe.toml");
-    let base = LearnConfig::from_toml_str(text).expect("the safe config parses");
-    assert!(base.planning.safety.enforce);
-    let safe_cell = |speed_case: &str, style| {
-        (base.clone())
-            .with_cell(CellChoice {
-                speed_case: speed_case.into(),
-                headway_m: 40.0,
-                seed: 1,
-            })
-            .with_user(UserConfig::preset(style))
-    };
     for style in StylePreset::ALL {
-        let learned = run(&safe_cell("collector-slow", style), None, &mut NoObserver)
-            .expect("the source run completes");
-        let target = safe_cell("collector-high", style);
+        let learned = run(
+            &safe_config("collector-slow", 40.0, style),
+            None,
+            &mut NoObserver,
+        )
+        .expect("the source run completes");
+        let target = safe_config("collector-high", 40.0, style);
+        assert!(target.planning.safety.enforce);
         let carried = LearningLoop::new(&target, Some(&learned.experience))
             .expect("the target scenario prepares");
         let anchor = (carried.experience().anchor_s).expect("the start is predicted");
@@ -188,21 +193,14 @@ fn under_the_safety_layer_the_predicted_lane_change_is_safe_throughout() {
     // distance before they stay there through a lane change; the users wait for
     // the latter, and so does the prediction (one that checked the start's step
     // alone started early, and every style took over).
-    let text = include_str!("../../../configs/learn-safe.toml");
-    let base = LearnConfig::from_toml_str(text).expect("the safe config parses");
-    let cell = |speed_case: &str, style| {
-        (base.clone())
-            .with_cell(CellChoice {
-                speed_case: speed_case.into(),
-                headway_m: 35.0,
-                seed: 1,
-            })
-            .with_user(UserConfig::preset(style))
-    };
     for style in StylePreset::ALL {
-        let learned = run(&cell("collector-slow", style), None, &mut NoObserver)
-            .expect("the source run completes");
-        let target = cell("collector-high", style);
+        let learned = run(
+            &safe_config("collector-slow", 35.0, style),
+            None,
+            &mut NoObserver,
+        )
+        .expect("the source run completes");
+        let target = safe_config("collector-high", 35.0, style);
         assert_start_predicted_to_the_step(&target, &learned.experience, style);
     }
 }
