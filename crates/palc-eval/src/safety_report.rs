@@ -28,7 +28,11 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
          the vehicle ahead in a lane it moves into and by the ACC's emergency brake in its \
          own lane; the lateral path stays the driver's (docs/paper-mapping.md, \"The \
          longitudinal guard\"). The paper's set-up otherwise holds every speed constant and \
-         has no safety layer; \
+         has no safety layer: under the layer alone none of its scenes has a safe lane change \
+         (the ego closes on the preceding vehicle, or on the target lane's platoon, below the \
+         safe distance) and every cell is refused, so its figures are measured on scenes the \
+         layer would refuse (docs/paper-mapping.md, \"The paper's scenes under the safety \
+         layer\"); \
          `configs/reproduce-safe.toml` is the same evaluation with the ego's ACC, the safety layer \
          and users who start only into gaps at the safe distance (`cargo xtask reproduce-paper` \
          writes its report to `safe/REPORT.md`, and the stress scenes of `configs/stress/` under \
