@@ -27,6 +27,14 @@ fn config(guard: bool, closed_loop: bool) -> LearnConfig {
     config
 }
 
+/// The error with which the loop refuses `config`'s scene, as a user reads it.
+fn refusal(config: &LearnConfig) -> String {
+    match palc_harness::LearningLoop::new(config, None) {
+        Ok(_) => panic!("the scene is refused"),
+        Err(error) => error.to_string(),
+    }
+}
+
 fn learn(config: &LearnConfig) -> RunResult {
     run(config, None, &mut NoObserver).expect("the scenario runs")
 }
@@ -103,10 +111,7 @@ fn a_scene_where_the_users_own_lane_change_collides_is_refused() {
         toml::from_str(r#"start = { rule = "time-to-collision", seconds = 8.0 }"#)
             .expect("a family table"),
     );
-    let Err(error) = palc_harness::LearningLoop::new(&config, None) else {
-        panic!("the scene is refused");
-    };
-    let message = error.to_string();
+    let message = refusal(&config);
     assert!(
         message.contains("collector-high / 35 m / seed 1"),
         "{message}"
@@ -176,10 +181,7 @@ fn a_user_holds_beside_the_follower_and_a_scene_where_its_own_lane_change_would_
             seed: 4,
         })
         .with_user(user);
-    let Err(error) = palc_harness::LearningLoop::new(&config, None) else {
-        panic!("the scene is refused");
-    };
-    let message = error.to_string();
+    let message = refusal(&config);
     assert!(
         message.contains("collector-high / 30 m / seed 4"),
         "{message}"
