@@ -25,13 +25,18 @@
 //! decision threshold) bounds the lead gap the user needs from below, the largest
 //! rejected gap of gap-acceptance models; and when every onset was held back by
 //! a follower alongside, the headway just before that follower arrived bounds the
-//! decision from above (the user had not started there). A start at a headway
-//! below the standard ALC's decision headway, with the follower's gap opening into
-//! it, is read as a wait for that gap (every user decides before the standard ALC
-//! does: the paper's premise). A lead gap the user accepted bounds the one it
-//! needs from above; until it has accepted one smaller than the standard ALC's
-//! requirement, that requirement is assumed (the system's own, not fitted to any
-//! user).
+//! decision from above (the user had not started there). The decision is then
+//! known within an interval and nothing in the scene prefers one threshold of it
+//! to another; the start predicted is the one that most of the interval leads to
+//! in the new scene (where a follower holds back every threshold of a part of it,
+//! that part starts at one step). A start at a headway below the standard ALC's
+//! decision headway, with the follower's gap opening into it, is read as a wait
+//! for that gap (every user decides before the standard ALC does: the paper's
+//! premise). A lead gap the user accepted bounds the one it needs from above;
+//! until it has accepted one smaller than the standard ALC's requirement, that
+//! requirement is assumed (the system's own, not fitted to any user).
+
+use std::collections::BTreeMap;
 
 use palc_aggregator::Onset;
 
@@ -441,9 +446,9 @@ fn waited_for_the_follower(setup: &Setup, step: usize) -> bool {
 /// time-to-collision users' 93 of 220 instead of 66 (docs/paper-mapping.md).
 ///
 /// When the gaps were never open before the follower came, that step is the
-/// fallback: the earliest start the wait allows, the same choice as for the
-/// threshold itself ([`decision`]). Without a ceiling the decision kept only its
-/// lower bound, the latest start the wait allows; with the fallback the transfer
+/// fallback: the earliest start the wait allows, the upper end of the interval
+/// the prediction weighs ([`predicted_start_s`]). Without a ceiling the decision
+/// kept only its lower bound, the latest start the wait allows; with the fallback the transfer
 /// matrix's pairs need 190 takeovers instead of 197 (deterministic users), and
 /// fewer or as many for every start rule (docs/paper-mapping.md). `None` when the
 /// follower was not alongside at the step before the start, or was alongside
@@ -540,14 +545,25 @@ impl Decision {
 /// user has shown). When every onset was held back, the time headway's threshold
 /// is raised to the lowest [`Onset::time_headway_ceiling_s`] above it: the
 /// earliest start the waits allow, assuming nothing but the follower held the
-/// user back. The feature is the time headway (the paper's user model and
-/// the usual measure of following) unless, over onsets from two or more scenes,
+/// user back ([`decision_range`] keeps the interval). The feature is the time
+/// headway (the paper's user model and the usual measure of following) unless,
+/// over onsets from two or more scenes,
 /// it varies by more than [`CONSISTENT_SPREAD`] while the time to collision or the
 /// gap does not, or a held-back onset started at a headway above the threshold
 /// (more than [`CONSISTENT_SPREAD`] above: a held-back start comes after the
 /// decision); then the most consistent of those that no held-back onset
 /// contradicts.
 fn decision(onsets: &[Onset]) -> (Decision, f64) {
+    let (feature, _, threshold) = decision_range(onsets);
+    (feature, threshold)
+}
+
+/// [`decision`] with the lowest threshold the onsets allow: `(feature, lowest,
+/// threshold)`. The two differ only when every onset was held back and a
+/// ceiling raised the time headway's threshold above the largest headway at
+/// which the user started (the onsets bound the decision to that interval and
+/// say nothing more).
+fn decision_range(onsets: &[Onset]) -> (Decision, f64, f64) {
     let onsets = &reread_follower_waits(onsets);
     let free: Vec<&Onset> = onsets
         .iter()
@@ -567,6 +583,7 @@ fn decision(onsets: &[Onset]) -> (Decision, f64) {
         (max > 0.0).then(|| ((max - min) / max, max))
     };
     let mut headway = spread(Decision::TimeHeadway).unwrap_or((0.0, 0.0));
+    let lowest_headway = headway.1;
     if free.is_empty() {
         // Only lower bounds: take the earliest start they allow, the lowest
         // headway at which a follower's arrival interrupted a wait.
@@ -598,10 +615,10 @@ fn decision(onsets: &[Onset]) -> (Decision, f64) {
             .filter(|&(d, spread, max)| spread <= CONSISTENT_SPREAD && !contradicted(d, max))
             .min_by(|a, b| a.1.total_cmp(&b.1));
         if let Some((feature, _, threshold)) = best {
-            return (feature, threshold);
+            return (feature, threshold, threshold);
         }
     }
-    (Decision::TimeHeadway, headway.1)
+    (Decision::TimeHeadway, lowest_headway, headway.1)
 }
 
 /// `onsets` with each start that was read as a wait for the follower
@@ -650,7 +667,15 @@ fn acceptance(onsets: &[Onset], gap: fn(&Onset) -> Option<f64>) -> f64 {
 /// its threshold, then the first step from there at which the target-lane gaps
 /// are at least the learned ones (for the leader, also above every lead gap the
 /// user refused after deciding, and at least the standard ALC's lead gap or the
-/// smallest one the user accepted, whichever is smaller). Under the safety layer
+/// smallest one the user accepted, whichever is smaller). When the onsets bound
+/// the time headway's threshold to an interval ([`decision_range`]; from below
+/// also by the standard ALC's decision headway, which every user's is above: the
+/// paper's premise), each threshold of it gives a start, and the start given by
+/// the largest part of the interval is predicted, the earliest of those within
+/// one step's fall of the headway of each other: a uniform belief over what the
+/// scenes allow, not a choice of one end. Taking
+/// the upper end (the earliest start, as for a free onset) started users held
+/// back in dense scenes up to 20 s early in sparser ones. Under the safety layer
 /// the gaps are also at the safe distance at every step of the carried lane
 /// change (`duration_s` from the start, on the lane-keeping prediction): a start
 /// whose lane change the layer would refuse is not predicted. `None` without
@@ -659,7 +684,7 @@ pub(crate) fn predicted_start_s(setup: &Setup, onsets: &[Onset], duration_s: f64
     if onsets.is_empty() {
         return None;
     }
-    let (feature, threshold) = decision(onsets);
+    let (feature, lowest, threshold) = decision_range(onsets);
     // A lead gap the user refused after deciding is below the one it needs.
     let refused = (onsets.iter())
         .filter_map(|o| o.rejected_lead_time_gap_s)
@@ -678,9 +703,6 @@ pub(crate) fn predicted_start_s(setup: &Setup, onsets: &[Onset], duration_s: f64
     let lead = (acceptance(onsets, |o| o.lead_time_gap_s).max(refused)).max(assumed);
     let lag = acceptance(onsets, |o| o.lag_time_gap_s);
     let situations = &setup.situations;
-    let decides = |s: &Situation| {
-        s.time_headway_s > 0.0 && feature.of_situation(s).is_some_and(|x| x <= threshold)
-    };
     // Under the safety layer a lane change below the safe distance would be
     // refused.
     let steps = (duration_s / setup.dt).ceil().max(0.0) as usize;
@@ -696,9 +718,79 @@ pub(crate) fn predicted_start_s(setup: &Setup, onsets: &[Onset], duration_s: f64
             && lag_time_gap(s).is_none_or(|g| g > 0.0 && g >= lag)
             && (!safety.enforce || safe_through(i))
     };
-    let decided = situations.iter().position(decides)?;
-    let start = (decided..situations.len()).find(|&i| accepts(i))?;
+    // Every user decides before the standard ALC would (the paper's premise,
+    // `Setup::check_conservative`): no time-headway threshold lies below the
+    // standard ALC's.
+    let lowest = match feature {
+        Decision::TimeHeadway => lowest.max(setup.standard_alc.time_headway_s),
+        _ => lowest,
+    };
+    let mut weight = BTreeMap::<usize, f64>::new();
+    let mut start = None;
+    let decisions = decision_steps(setup, feature, (lowest.min(threshold), threshold));
+    // The interval is resolved in steps: parts within one step's fall of the
+    // feature are equal, and a start wins only by more than that.
+    let resolution = decisions.iter().map(|&(_, w)| w).fold(0.0, f64::max);
+    for (decided, width) in decisions {
+        // The first accepted step from an earlier decision is the first from
+        // this one too, unless this decision comes after it.
+        if start.is_none_or(|s| s < decided) {
+            start = (decided..situations.len()).find(|&i| accepts(i));
+        }
+        if let Some(start) = start {
+            *weight.entry(start).or_default() += width;
+        }
+    }
+    // The start most thresholds lead to; the earliest of equals (with a free
+    // fall of the feature every step's thresholds start at their own step, and
+    // the earliest is the start a free onset's threshold gives).
+    let (start, _) =
+        (weight.into_iter()).fold(None, |best: Option<(usize, f64)>, (start, w)| match best {
+            Some((_, b)) if b + resolution >= w => best,
+            _ => Some((start, w)),
+        })?;
     Some(start as f64 * setup.dt)
+}
+
+/// The steps at which thresholds of `feature` in `range` decide, each with the
+/// length of the part of `range` that decides there: a threshold decides at the
+/// first step at which the feature has fallen to it (behind a positive time
+/// headway). A range of one value decides at one step, with weight 1.
+fn decision_steps(
+    setup: &Setup,
+    feature: Decision,
+    (lowest, highest): (f64, f64),
+) -> Vec<(usize, f64)> {
+    let value = |s: &Situation| {
+        (s.time_headway_s > 0.0)
+            .then(|| feature.of_situation(s))
+            .flatten()
+    };
+    let situations = &setup.situations;
+    if lowest >= highest {
+        return (situations.iter())
+            .position(|s| value(s).is_some_and(|x| x <= highest))
+            .map(|i| vec![(i, 1.0)])
+            .unwrap_or_default();
+    }
+    let mut steps = Vec::new();
+    // Thresholds at or above `above` have decided at an earlier step.
+    let mut above = f64::INFINITY;
+    for (i, s) in situations.iter().enumerate() {
+        let Some(x) = value(s).filter(|&x| x < above) else {
+            continue;
+        };
+        // Thresholds in [x, above) decide here.
+        let width = above.min(highest) - x.max(lowest);
+        if width > 0.0 {
+            steps.push((i, width));
+        }
+        above = x;
+        if x <= lowest {
+            break;
+        }
+    }
+    steps
 }
 
 #[cfg(test)]
@@ -987,6 +1079,44 @@ mod tests {
         // A free onset gives the threshold itself.
         let with_free = [held(0.6, Some(1.5)), onset(1.2, 10.0, None)];
         assert_eq!(decision(&with_free).1, 1.2);
+    }
+
+    /// The default scene's set-up at arterial-high / 45 m, seed 1.
+    fn arterial_setup() -> Setup {
+        let text = include_str!("../../../configs/learn.toml");
+        let config = crate::config::LearnConfig::from_toml_str(text)
+            .unwrap()
+            .with_cell(crate::config::CellChoice {
+                speed_case: "arterial-high".into(),
+                headway_m: 45.0,
+                seed: 1,
+            });
+        crate::learn::prepare(&config).unwrap()
+    }
+
+    #[test]
+    fn the_thresholds_of_a_range_decide_at_steps_that_share_it_out() {
+        let setup = arterial_setup();
+        let headway = |i: usize| setup.situations[i].time_headway_s;
+        let range = (1.0, 2.07);
+        let steps = decision_steps(&setup, Decision::TimeHeadway, range);
+        assert!(steps.len() > 10, "{steps:?}");
+        // The headway falls through the whole range within the window: the
+        // widths share it out, at increasing steps, each where its thresholds
+        // are first reached.
+        let total: f64 = steps.iter().map(|&(_, w)| w).sum();
+        assert!((total - (range.1 - range.0)).abs() < 1e-9, "{total}");
+        for pair in steps.windows(2) {
+            assert!(pair[0].0 < pair[1].0);
+        }
+        for &(i, width) in &steps {
+            assert!(width > 0.0 && headway(i) < range.1 && headway(i - 1) > range.0);
+        }
+        // One value decides at one step: the first at or below it.
+        let one = decision_steps(&setup, Decision::TimeHeadway, (1.5, 1.5));
+        let first = (setup.situations.iter())
+            .position(|s| s.time_headway_s > 0.0 && s.time_headway_s <= 1.5);
+        assert_eq!(one, vec![(first.unwrap(), 1.0)]);
     }
 
     #[test]

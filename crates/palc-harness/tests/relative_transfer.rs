@@ -372,6 +372,30 @@ fn a_follower_that_came_before_any_open_gap_still_bounds_the_decision() {
 }
 
 #[test]
+fn a_decision_known_within_an_interval_predicts_the_start_most_of_it_leads_to() {
+    // At arterial-high / 35 m the aggressive user (1.15 s) is held back by a
+    // follower alongside until a headway of 0.93 s; before it came, the gaps
+    // were open at 2.07 s, where the user had not started. The scene bounds the
+    // decision to that interval (at least the standard ALC's 1.0 s, by the
+    // paper's premise) and says nothing more. Taking the earliest start it
+    // allows (the ceiling) started the carried lane change at 45 m 20 s before
+    // the user (2.9 s against 23.0 s); the start that most thresholds of the
+    // interval lead to is the user's.
+    let style = StylePreset::Aggressive;
+    let experience = learned_in(&config("arterial-high", 35.0, style));
+    let onset = experience.onsets.last().expect("an onset");
+    assert!(onset.lag_time_gap_s.is_some(), "the follower held it back");
+    let ceiling = onset.time_headway_ceiling_s.expect("a ceiling");
+    assert!(
+        ceiling > onset.time_headway_s + 0.5,
+        "ceiling {ceiling} s, start at {} s",
+        onset.time_headway_s
+    );
+    let target = config("arterial-high", 45.0, style);
+    assert_start_predicted_to_the_step(&target, &experience, style);
+}
+
+#[test]
 fn a_start_after_the_follower_has_left_is_a_decision_not_a_wait() {
     // At collector-high / 30 m the cautious user starts at its own threshold
     // (1.76 s), a few steps after the target lane's follower left the ego's side.
