@@ -1,0 +1,45 @@
+//! The user's start of a lane change in relative space: observed in a lesson,
+//! predicted in a new scene (docs/paper-mapping.md, "Experience in relative space").
+//!
+//! A takeover shows the user's own lateral profile from the takeover on. Its start
+//! is found by fitting a lane-change model through two crossings of it ([`Shape`]):
+//! the paper's quintic or a half-sine lateral speed, each symmetric or skewed (its
+//! lateral speed peaking earlier or later than mid-move), keeping the model closest
+//! to the profile up to the upper crossing. With `x(p)` the inverse of the model's
+//! `p(x)` (for the quintic `10x³ − 15x⁴ + 6x⁵`), crossings of the fractions
+//! `p_a < p_b` of the lane change at `t_a` and `t_b` give the duration
+//! `D = (t_b − t_a) / (x(p_b) − x(p_a))` and the start `t_a − x(p_a) · D`. The
+//! crossings are interpolated between steps, so the start is found to a fraction
+//! of a step; a profile outside the models (a table, a seventh-order polynomial)
+//! biases it by a few percent of its duration.
+//!
+//! The relative state at that start ([`Onset`]: time headway, time to collision
+//! and gap to the vehicle ahead, and a target-lane gap when it held the user back)
+//! is what carries. In a new scene the start is predicted with the structure of a
+//! gap-acceptance driver: the user decides when the decision feature falls to
+//! the learned threshold, then starts at the first step from there where the
+//! target-lane gaps are at least the learned ones ([`predicted_start_s`]).
+//!
+//! What one scene cannot show is bounded from what the user refused: a lead gap
+//! refused after the decision (a scene's onset learned with earlier scenes'
+//! decision threshold) bounds the lead gap the user needs from below, the largest
+//! rejected gap of gap-acceptance models; and when every onset was held back by
+//! a follower alongside, the headway just before that follower arrived bounds the
+//! decision from above (the user had not started there). The decision is then
+//! known within an interval and nothing in the scene prefers one threshold of it
+//! to another; the start predicted is the one that most of the interval leads to
+//! in the new scene (where a follower holds back every threshold of a part of it,
+//! that part starts at one step). A start at a headway below the standard ALC's
+//! decision headway, with the follower's gap opening into it, is read as a wait
+//! for that gap (every user decides before the standard ALC does: the paper's
+//! premise). A lead gap the user accepted bounds the one it needs from above;
+//! until it has accepted one smaller than the standard ALC's requirement, that
+//! requirement is assumed (the system's own, not fitted to any user).
+
+mod fit;
+mod prediction;
+
+#[cfg(test)]
+pub(crate) use fit::Shape;
+pub(crate) use fit::UserLaneChange;
+pub(crate) use prediction::{onset_at, predicted_start_s};
