@@ -446,13 +446,13 @@ pub(crate) fn predicted_start_s(setup: &Setup, onsets: &[Onset], duration_s: f64
     let resolution = decisions.iter().map(|&(_, w)| w).fold(0.0, f64::max);
     for (decided, width) in decisions {
         // The first accepted step from an earlier decision is the first from
-        // this one too, unless this decision comes after it.
+        // this one too, unless this decision comes after it; with none from an
+        // earlier decision there is none from a later one.
         if start.is_none_or(|s| s < decided) {
             start = (decided..situations.len()).find(|&i| accepts(i));
         }
-        if let Some(start) = start {
-            *weight.entry(start).or_default() += width;
-        }
+        let Some(start) = start else { break };
+        *weight.entry(start).or_default() += width;
     }
     // The start most thresholds lead to; the earliest of equals (with a free
     // fall of the feature every step's thresholds start at their own step, and
