@@ -456,7 +456,7 @@ pub(crate) fn predicted_start_s(setup: &Setup, onsets: &[Onset], duration_s: f64
     }
     // The start most thresholds lead to; the earliest of equals (with a free
     // fall of the feature every step's thresholds start at their own step, and
-    // the earliest is the start a free onset's threshold gives).
+    // the earliest is the one the interval's upper end, the ceiling, gives).
     let (start, _) =
         (weight.into_iter()).fold(None, |best: Option<(usize, f64)>, (start, w)| match best {
             Some((_, b)) if b + resolution >= w => best,
