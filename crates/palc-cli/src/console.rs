@@ -91,6 +91,63 @@ pub fn is_broken_pipe(error: &anyhow::Error) -> bool {
 /// Reports the error that ends the command on stderr, if stderr is still open.
 pub fn report(error: &anyhow::Error) {
     if !STDERR_CLOSED.load(Ordering::Relaxed) {
-        let _ = writeln!(io::stderr().lock(), "Error: {error:?}");
+        let _ = writeln!(io::stderr().lock(), "{}", rendered(error));
+    }
+}
+
+/// `error` for the user: its message, then each cause the message above it
+/// does not already quote (the library errors name their cause in their own
+/// message, so a plain chain said the operating system's error twice), then
+/// the backtrace when one was captured (`RUST_BACKTRACE=1`).
+fn rendered(error: &anyhow::Error) -> String {
+    let mut text = format!("Error: {error}");
+    let mut above = error.to_string();
+    for cause in error.chain().skip(1) {
+        let message = cause.to_string();
+        if !above.contains(&message) {
+            text.push_str(&format!("\n  caused by: {message}"));
+        }
+        above = message;
+    }
+    let backtrace = error.backtrace();
+    if backtrace.status() == std::backtrace::BacktraceStatus::Captured {
+        text.push_str(&format!("\n\nStack backtrace:\n{backtrace}"));
+    }
+    text
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_cause_the_message_already_quotes_is_not_repeated() {
+        let io = io::Error::new(io::ErrorKind::NotFound, "No such file or directory");
+        let error = anyhow::Error::new(io)
+            .context("experience file /x.json: No such file or directory")
+            .context("cannot load /x.json");
+        let text = rendered(&error);
+        let first_line = text.lines().take(2).collect::<Vec<_>>();
+        assert_eq!(
+            first_line,
+            [
+                "Error: cannot load /x.json",
+                "  caused by: experience file /x.json: No such file or directory",
+            ]
+        );
+        assert_eq!(
+            text.matches("No such file or directory").count(),
+            1,
+            "{text}"
+        );
+    }
+
+    #[test]
+    fn a_cause_the_message_does_not_quote_is_shown() {
+        let error = anyhow::anyhow!("the scene is too short").context("cannot run the cell");
+        assert!(
+            rendered(&error)
+                .starts_with("Error: cannot run the cell\n  caused by: the scene is too short")
+        );
     }
 }
