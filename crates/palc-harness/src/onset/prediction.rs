@@ -618,42 +618,68 @@ mod tests {
         assert_eq!(decision(&with_free).1, 1.2);
     }
 
-    /// The default scene's set-up at arterial-high / 45 m, seed 1.
-    fn arterial_setup() -> Setup {
-        let text = include_str!("../../../../configs/learn.toml");
-        let config = crate::config::LearnConfig::from_toml_str(text)
-            .unwrap()
-            .with_cell(crate::config::CellChoice {
-                speed_case: "arterial-high".into(),
-                headway_m: 45.0,
-                seed: 1,
-            });
-        crate::learn::prepare(&config).unwrap()
+    /// The default scene's set-up at arterial-high / 45 m, seed 1 (prepared once).
+    fn arterial_setup() -> &'static Setup {
+        static SETUP: std::sync::OnceLock<Setup> = std::sync::OnceLock::new();
+        SETUP.get_or_init(|| {
+            let text = include_str!("../../../../configs/learn.toml");
+            let config = crate::config::LearnConfig::from_toml_str(text)
+                .unwrap()
+                .with_cell(crate::config::CellChoice {
+                    speed_case: "arterial-high".into(),
+                    headway_m: 45.0,
+                    seed: 1,
+                });
+            crate::learn::prepare(&config).unwrap()
+        })
+    }
+
+    /// The first step at which a threshold of the time headway decides, by its
+    /// definition: the slower reference of [`decision_steps`].
+    fn deciding_step(setup: &Setup, threshold: f64) -> Option<usize> {
+        (setup.situations.iter())
+            .position(|s| s.time_headway_s > 0.0 && s.time_headway_s <= threshold)
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(64))]
+
+        /// Over any range the headway falls through in the scene (from 3 s at
+        /// its start to below 0.5 s), the widths share the range out at
+        /// increasing steps, and each step is where the thresholds of its part
+        /// decide by definition.
+        #[test]
+        fn the_thresholds_of_a_range_decide_at_steps_that_share_it_out(
+            lowest in 0.5f64..2.5,
+            width in 0.001f64..0.5,
+        ) {
+            let setup = arterial_setup();
+            let range = (lowest, lowest + width);
+            let steps = decision_steps(setup, Decision::TimeHeadway, range);
+            let total: f64 = steps.iter().map(|&(_, w)| w).sum();
+            proptest::prop_assert!((total - width).abs() < 1e-9, "{} against {}", total, width);
+            for pair in steps.windows(2) {
+                proptest::prop_assert!(pair[0].0 < pair[1].0);
+            }
+            for &(i, part) in &steps {
+                let threshold = setup.situations[i].time_headway_s.max(range.0);
+                proptest::prop_assert!(part > 0.0);
+                proptest::prop_assert_eq!(deciding_step(setup, threshold), Some(i));
+            }
+            // Every threshold of the range decides at one of the steps.
+            for k in 0..=4 {
+                let threshold = range.0 + width * f64::from(k) / 4.0;
+                let step = deciding_step(setup, threshold).unwrap();
+                proptest::prop_assert!(steps.iter().any(|&(i, _)| i == step), "{}", threshold);
+            }
+        }
     }
 
     #[test]
-    fn the_thresholds_of_a_range_decide_at_steps_that_share_it_out() {
+    fn one_threshold_decides_at_one_step() {
         let setup = arterial_setup();
-        let headway = |i: usize| setup.situations[i].time_headway_s;
-        let range = (1.0, 2.07);
-        let steps = decision_steps(&setup, Decision::TimeHeadway, range);
-        assert!(steps.len() > 10, "{steps:?}");
-        // The headway falls through the whole range within the window: the
-        // widths share it out, at increasing steps, each where its thresholds
-        // are first reached.
-        let total: f64 = steps.iter().map(|&(_, w)| w).sum();
-        assert!((total - (range.1 - range.0)).abs() < 1e-9, "{total}");
-        for pair in steps.windows(2) {
-            assert!(pair[0].0 < pair[1].0);
-        }
-        for &(i, width) in &steps {
-            assert!(width > 0.0 && headway(i) < range.1 && headway(i - 1) > range.0);
-        }
-        // One value decides at one step: the first at or below it.
-        let one = decision_steps(&setup, Decision::TimeHeadway, (1.5, 1.5));
-        let first = (setup.situations.iter())
-            .position(|s| s.time_headway_s > 0.0 && s.time_headway_s <= 1.5);
-        assert_eq!(one, vec![(first.unwrap(), 1.0)]);
+        let one = decision_steps(setup, Decision::TimeHeadway, (1.5, 1.5));
+        assert_eq!(one, vec![(deciding_step(setup, 1.5).unwrap(), 1.0)]);
     }
 
     #[test]
