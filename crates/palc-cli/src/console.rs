@@ -127,9 +127,9 @@ mod tests {
             .context("experience file /x.json: No such file or directory")
             .context("cannot load /x.json");
         let text = rendered(&error);
-        let first_line = text.lines().take(2).collect::<Vec<_>>();
+        let first_lines = text.lines().take(2).collect::<Vec<_>>();
         assert_eq!(
-            first_line,
+            first_lines,
             [
                 "Error: cannot load /x.json",
                 "  caused by: experience file /x.json: No such file or directory",
