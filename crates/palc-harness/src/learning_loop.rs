@@ -259,7 +259,10 @@ impl LearningLoop {
                     self.learn(index, &drive, takeover.step, observer)?;
                 }
             }
-            None => self.streak += 1,
+            None => {
+                self.streak += 1;
+                self.accepted(&drive);
+            }
         }
         Ok(&self.records[index])
     }
@@ -502,11 +505,18 @@ impl LearningLoop {
                 state.l = l;
             }
         }
+        // Whether the lesson shows where the user starts in this scene's gap.
+        let mut onset_seen = user.is_some();
         if let (Some(user), true) = (user, self.options.average_lessons) {
             // The expert follows the mean of this scene's lessons (scene_lessons.rs).
+            // A lesson in a gap the scene's lane changes do not point to leaves the
+            // plan as it is: its expert is the plan driven.
             let path: Vec<f64> = lesson.executed.iter().map(|x| x.l).collect();
             let mean = self.scene_lessons.add(user, path, dt);
-            for (state, l) in lesson.executed.iter_mut().zip(mean) {
+            onset_seen = mean.includes_lesson;
+            let path =
+                (mean.path).unwrap_or_else(|| drive.plan.states.iter().map(|x| x.l).collect());
+            for (state, l) in lesson.executed.iter_mut().zip(path) {
                 state.l = l;
             }
         }
@@ -533,7 +543,7 @@ impl LearningLoop {
                 self.pending_times = outcome.timings;
                 self.experience = outcome.experience;
                 self.next_plan = outcome.plan;
-                if let Some(user) = user {
+                if let (Some(user), true) = (user, onset_seen) {
                     self.observe_onset(user.start_s);
                 }
             }
@@ -551,6 +561,19 @@ impl LearningLoop {
             }
         }
         Ok(())
+    }
+
+    /// Counts a lane change the user accepted in this scene's lessons (with
+    /// `average_lessons`): it tells which gap of the target lane the user takes.
+    fn accepted(&mut self, drive: &Drive) {
+        if !self.options.average_lessons {
+            return;
+        }
+        let driven_l: Vec<f64> = drive.driven.iter().map(|x| x.l).collect();
+        let (dt, target_l) = (self.setup.dt, self.setup.target_l);
+        if let Some(driven) = UserLaneChange::fit(&driven_l, 0, dt, target_l) {
+            self.scene_lessons.accept(driven.start_s);
+        }
     }
 
     /// Records the user's start `start_s` seen in a lesson in the experience:

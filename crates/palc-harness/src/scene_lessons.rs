@@ -18,6 +18,15 @@
 //! so averaging costs them nothing; for a user with spread the start, duration
 //! and shape each converge to their means (step `1/n`), whatever the profile's
 //! shape.
+//!
+//! Which gap the user takes is decided by every lane change of the scene, not by
+//! the lessons alone: a lane change the user accepted started within the
+//! takeover threshold of the user's, so in the user's gap, and it counts there as
+//! one start. Lessons exist only where a draw strayed from the plan, so while the
+//! plan follows the gap most draws take, the lessons come from the others; counted
+//! alone, a minority gap's lessons outnumbered the majority's and the plan moved
+//! to the gap most draws do not take. A lesson in a gap the scene's lane changes
+//! do not point to leaves the plan as it is.
 
 use crate::onset::UserLaneChange;
 
@@ -26,48 +35,85 @@ use crate::onset::UserLaneChange;
 #[derive(Debug, Clone, Default)]
 pub(crate) struct SceneLessons {
     seen: Vec<(UserLaneChange, Vec<f64>)>,
+    /// The starts (s) of the lane changes of the scene the user accepted.
+    accepted_starts_s: Vec<f64>,
+}
+
+/// What a lesson's expert follows, from [`SceneLessons::add`].
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct SceneMean {
+    /// The mean path (m, one value per step) of the lessons in the gap the scene's
+    /// lane changes point to; `None` when no lesson took that gap (the plan stays).
+    pub(crate) path: Option<Vec<f64>>,
+    /// Whether the lesson just added is one of them: a lesson into another gap
+    /// tells nothing of where the user starts in this one.
+    pub(crate) includes_lesson: bool,
 }
 
 impl SceneLessons {
+    /// Counts a lane change the user accepted, which started at `start_s`.
+    pub(crate) fn accept(&mut self, start_s: f64) {
+        self.accepted_starts_s.push(start_s);
+    }
+
     /// Adds a lesson and returns the mean path of the lessons so far that started
-    /// with the median start (within one lane-change duration of it), at steps
-    /// `0..path.len()` of `dt`. A path of another length than the first (another
-    /// horizon) starts the mean again.
-    pub(crate) fn add(&mut self, user: UserLaneChange, path: Vec<f64>, dt: f64) -> Vec<f64> {
+    /// with the median start of the scene's lane changes (within one lane-change
+    /// duration of it), at steps `0..path.len()` of `dt`. A path of another length
+    /// than the first (another horizon) starts the scene again.
+    pub(crate) fn add(&mut self, user: UserLaneChange, path: Vec<f64>, dt: f64) -> SceneMean {
         if self
             .seen
             .first()
             .is_some_and(|(_, p)| p.len() != path.len())
         {
             self.seen.clear();
+            self.accepted_starts_s.clear();
         }
         self.seen.push((user, path));
         let mode = self.mode();
+        let includes_lesson = mode.last() == Some(&(self.seen.len() - 1));
+        if mode.is_empty() {
+            return SceneMean {
+                path: None,
+                includes_lesson,
+            };
+        }
         let n = mode.len() as f64;
-        let start = mode.iter().map(|(u, _)| u.start_s).sum::<f64>() / n;
-        let duration = mode.iter().map(|(u, _)| u.duration_s).sum::<f64>() / n;
+        let lessons = || mode.iter().map(|&i| &self.seen[i]);
+        let start = lessons().map(|(u, _)| u.start_s).sum::<f64>() / n;
+        let duration = lessons().map(|(u, _)| u.duration_s).sum::<f64>() / n;
         let steps = self.seen[0].1.len();
-        (0..steps)
+        let mean = (0..steps)
             .map(|i| {
                 let fraction = (i as f64 * dt - start) / duration;
-                let sum: f64 = (mode.iter())
+                let sum: f64 = lessons()
                     .map(|(u, p)| sampled(p, (u.start_s + fraction * u.duration_s) / dt))
                     .sum();
                 sum / n
             })
-            .collect()
+            .collect();
+        SceneMean {
+            path: Some(mean),
+            includes_lesson,
+        }
     }
 
-    /// The lessons that started with the median start: within one lane-change
+    /// The indices of the lessons that started with the median start of the
+    /// scene's lane changes (lessons and accepted ones): within one lane-change
     /// duration of it. A start further away is another decision (the user took
     /// another gap of the target lane), and a mean across two gaps is a lane
     /// change into neither.
-    fn mode(&self) -> Vec<&(UserLaneChange, Vec<f64>)> {
-        let mut starts: Vec<f64> = self.seen.iter().map(|(u, _)| u.start_s).collect();
+    fn mode(&self) -> Vec<usize> {
+        let mut starts: Vec<f64> = (self.seen.iter().map(|(u, _)| u.start_s))
+            .chain(self.accepted_starts_s.iter().copied())
+            .collect();
         starts.sort_by(f64::total_cmp);
-        let median = starts[(starts.len() - 1) / 2];
-        (self.seen.iter())
-            .filter(|(u, _)| (u.start_s - median).abs() <= u.duration_s)
+        let Some(&median) = starts.get(starts.len().saturating_sub(1) / 2) else {
+            return Vec::new();
+        };
+        (self.seen.iter().enumerate())
+            .filter(|(_, (u, _))| (u.start_s - median).abs() <= u.duration_s)
+            .map(|(i, _)| i)
             .collect()
     }
 }
@@ -108,7 +154,7 @@ mod tests {
         let mut mean = Vec::new();
         for start in [4.0, 13.0, 4.2] {
             let (user, path) = lane_change(start, 2.0);
-            mean = lessons.add(user, path, DT);
+            mean = lessons.add(user, path, DT).path.unwrap();
         }
         let (_, expected) = lane_change(4.1, 2.0);
         for (a, b) in mean.iter().zip(&expected) {
@@ -117,11 +163,53 @@ mod tests {
     }
 
     #[test]
+    fn the_lane_changes_the_user_accepted_choose_the_gap() {
+        // One lesson into the gap at 13 s, then three lane changes there the user
+        // accepted: a lesson into the gap at 4 s (a draw that decided early) does
+        // not move the plan, however many such lessons come while the plan is
+        // right.
+        let mut lessons = SceneLessons::default();
+        let (late, late_path) = lane_change(13.0, 2.0);
+        lessons.add(late, late_path.clone(), DT);
+        for start in [12.9, 13.0, 13.1] {
+            lessons.accept(start);
+        }
+        for start in [4.0, 4.1] {
+            let (early, path) = lane_change(start, 2.0);
+            let mean = lessons.add(early, path, DT);
+            assert!(!mean.includes_lesson);
+            for (a, b) in mean.path.unwrap().iter().zip(&late_path) {
+                assert!((a - b).abs() < 1e-9, "{a} != {b}");
+            }
+        }
+        // Counted alone, the two early lessons would have outvoted the late one.
+        let mut alone = SceneLessons::default();
+        alone.add(late, late_path, DT);
+        for start in [4.0, 4.1] {
+            let (early, path) = lane_change(start, 2.0);
+            alone.add(early, path, DT);
+        }
+        assert_eq!(alone.mode().len(), 2);
+    }
+
+    #[test]
+    fn a_lesson_in_a_gap_no_lane_change_points_to_leaves_the_plan() {
+        let mut lessons = SceneLessons::default();
+        for start in [12.9, 13.0, 13.1] {
+            lessons.accept(start);
+        }
+        let (early, path) = lane_change(4.0, 2.0);
+        let mean = lessons.add(early, path, DT);
+        assert_eq!(mean.path, None);
+        assert!(!mean.includes_lesson);
+    }
+
+    #[test]
     fn a_repeated_lane_change_is_its_own_mean() {
         let (user, path) = lane_change(4.03, 2.1);
         let mut lessons = SceneLessons::default();
         for _ in 0..3 {
-            let mean = lessons.add(user, path.clone(), DT);
+            let mean = lessons.add(user, path.clone(), DT).path.unwrap();
             for (a, b) in mean.iter().zip(&path) {
                 assert!((a - b).abs() < 1e-12, "{a} != {b}");
             }
@@ -134,7 +222,7 @@ mod tests {
         let mut mean = Vec::new();
         for (start, duration) in [(4.0, 2.0), (4.4, 2.2), (3.8, 1.9), (4.2, 2.3)] {
             let (user, path) = lane_change(start, duration);
-            mean = lessons.add(user, path, DT);
+            mean = lessons.add(user, path, DT).path.unwrap();
         }
         let (_, expected) = lane_change(4.1, 2.1);
         for (i, (a, b)) in mean.iter().zip(&expected).enumerate() {
@@ -149,7 +237,7 @@ mod tests {
         lessons.add(user, path, DT);
         let (user, path) = lane_change(5.0, 2.5);
         let short: Vec<f64> = path[..100].to_vec();
-        let mean = lessons.add(user, short.clone(), DT);
+        let mean = lessons.add(user, short.clone(), DT).path.unwrap();
         assert_eq!(mean.len(), short.len());
         for (a, b) in mean.iter().zip(&short) {
             assert!((a - b).abs() < 1e-12, "{a} != {b}");
