@@ -261,7 +261,7 @@ impl LearningLoop {
             }
             None => {
                 self.streak += 1;
-                self.accepted(&drive);
+                self.count_accepted(&drive);
             }
         }
         Ok(&self.records[index])
@@ -565,7 +565,7 @@ impl LearningLoop {
 
     /// Counts a lane change the user accepted in this scene's lessons (with
     /// `average_lessons`): it tells which gap of the target lane the user takes.
-    fn accepted(&mut self, drive: &Drive) {
+    fn count_accepted(&mut self, drive: &Drive) {
         if !self.options.average_lessons {
             return;
         }
