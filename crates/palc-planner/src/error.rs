@@ -110,7 +110,7 @@ pub enum PlanError {
         value: f64,
     },
     /// An input number is finite but outside its allowed range.
-    #[error("`{field}` = {value} is out of range: must be {bound}")]
+    #[error("`{field}` = {value:?} is out of range: must be {bound}")]
     OutOfRange {
         /// The input with its index.
         field: String,

@@ -45,7 +45,7 @@ pub enum ConfigError {
     },
     /// A vehicle starts faster than its IDM desired speed v0, which it cannot hold.
     #[error(
-        "`{field}` = {speed_mps} m/s is above the desired speed v0 = {v0_mps} m/s that the IDM can hold"
+        "`{field}` = {speed_mps:?} m/s is above the desired speed v0 = {v0_mps:?} m/s that the IDM can hold"
     )]
     SpeedAboveDesired {
         /// Dotted path of the field that sets the initial speed.
@@ -70,7 +70,7 @@ pub enum ConfigError {
     },
     /// The IDM cannot hold the background speed at this headway with any positive time gap.
     #[error(
-        "`{field}` = {headway_m} m cannot be held at {speed_mps} m/s: the IDM needs a front-to-front headway above {min_m} m"
+        "`{field}` = {headway_m:?} m cannot be held at {speed_mps:?} m/s: the IDM needs a front-to-front headway above {min_m:?} m"
     )]
     HeadwayCannotHold {
         /// Dotted path of the field.
@@ -84,7 +84,7 @@ pub enum ConfigError {
     },
     /// Two vehicles on the same lane overlap (net gap not positive) at the start.
     #[error(
-        "vehicles {back:?} and {front:?} overlap on lane {lane:?} at the start: net gap {gap_m} m must be above 0 m"
+        "vehicles {back:?} and {front:?} overlap on lane {lane:?} at the start: net gap {gap_m:?} m must be above 0 m"
     )]
     Overlap {
         /// Lane of both vehicles.
@@ -98,7 +98,7 @@ pub enum ConfigError {
     },
     /// A vehicle would start outside the road section.
     #[error(
-        "vehicle {id:?} would start at s = {s_m} m, outside the road section [0, {length_m}] m (`{hint}`)"
+        "vehicle {id:?} would start at s = {s_m:?} m, outside the road section [0, {length_m:?}] m (`{hint}`)"
     )]
     OutsideSection {
         /// The vehicle.

@@ -167,7 +167,7 @@ fn speeds_above_v0_that_cannot_be_held_are_refused() {
             TESTBED.replace("[40.0]", "[30.0]")
         ),
         &[
-            "`testbed.adjacent_headways_m` = 30 m cannot be held",
+            "`testbed.adjacent_headways_m` = 30.0 m cannot be held",
             "above",
         ],
     );
@@ -205,7 +205,7 @@ fn vehicles_outside_the_section_are_refused() {
             "initial_time_headway_s = 9.0",
         ),
         &[
-            "outside the road section [0, 200]",
+            "outside the road section [0, 200.0]",
             "testbed.initial_time_headway_s",
         ],
     );

@@ -24,7 +24,7 @@ pub enum ZoneError {
         value: f64,
     },
     /// Time-based features divide by the ego speed, which must be positive.
-    #[error("{field} = {value} m/s must be positive for the time-gap feature set")]
+    #[error("{field} = {value:?} m/s must be positive for the time-gap feature set")]
     NonPositiveSpeed {
         /// Which input was wrong.
         field: String,
