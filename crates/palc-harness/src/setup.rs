@@ -117,6 +117,30 @@ impl PlanningConfig {
         if !self.target_l.is_finite() {
             return Err(invalid("planning.target_l", self.target_l, "finite"));
         }
+        // Each of these becomes a number of steps of `dt` the set-up allocates and
+        // walks through: bounded like a prediction (`palc_traffic::MAX_HORIZON_STEPS`).
+        let longest_s = palc_traffic::MAX_HORIZON_STEPS as f64 * self.dt;
+        let durations = [
+            ("planning.max_approach_s", self.max_approach_s),
+            ("planning.search_window_s", self.search_window_s),
+            (
+                "planning.standard_alc_min_delay_s",
+                self.standard_alc_min_delay_s,
+            ),
+            ("planning.horizon_margin_s", self.horizon_margin_s),
+        ];
+        for (field, value) in durations {
+            if value > longest_s {
+                return Err(invalid(
+                    field,
+                    value,
+                    &format!(
+                        "at most {longest_s:?} s ({} steps of planning.dt)",
+                        palc_traffic::MAX_HORIZON_STEPS
+                    ),
+                ));
+            }
+        }
         self.standard_alc.validate("planning.standard_alc")?;
         self.acc.validate("planning.acc")?;
         self.safety.validate("planning.safety")?;
@@ -295,9 +319,8 @@ impl Setup {
             .find(|&start| {
                 behind(start)
                     && (!config.safety.enforce
-                        || situations[start..=start + duration]
-                            .iter()
-                            .all(|s| target_gaps_safe(s, &config.safety)))
+                        || (situations.get(start..=start + duration))
+                            .is_some_and(|w| w.iter().all(|s| target_gaps_safe(s, &config.safety))))
             })
             .ok_or_else(|| {
                 let reason = if config.safety.enforce {

@@ -225,6 +225,15 @@ fn invalid_configs_are_refused_naming_the_field() {
         assert!(err.contains(name), "{err}");
     }
 
+    // A window of 1e9 s at dt = 0.1 s would be 1e10 steps to allocate.
+    let mut bad = config(Method::Palc, "neutral");
+    bad.planning.search_window_s = 1e9;
+    let err = run(&bad, None, &mut NoObserver).unwrap_err().to_string();
+    assert!(
+        err.contains("planning.search_window_s") && err.contains("at most"),
+        "{err}"
+    );
+
     let mut bad = config(Method::Palc, "neutral");
     bad.cell.speed_case = "autobahn".to_owned();
     let err = run(&bad, None, &mut NoObserver).unwrap_err().to_string();

@@ -92,12 +92,29 @@ impl BoundsConfig {
                 bound: "positive and at most the width of lateral_range",
             });
         }
+        // At most a million grid cells: the scan allocates and evaluates each.
+        if self.grid_step < (hi - lo) * 1e-6 {
+            return Err(ZoneError::InvalidConfig {
+                field: "grid_step",
+                value: self.grid_step,
+                bound: "at least 1e-6 of the width of lateral_range (a million cells)",
+            });
+        }
         if !(self.tolerance.is_finite() && self.tolerance > 0.0 && self.tolerance <= self.grid_step)
         {
             return Err(ZoneError::InvalidConfig {
                 field: "tolerance",
                 value: self.tolerance,
                 bound: "positive and at most grid_step",
+            });
+        }
+        // The bisection halves an interval until it is narrower than the tolerance;
+        // below the spacing of doubles at the range's ends it would never get there.
+        if self.tolerance < 1e-9 * lo.abs().max(hi.abs()).max(1.0) {
+            return Err(ZoneError::InvalidConfig {
+                field: "tolerance",
+                value: self.tolerance,
+                bound: "at least 1e-9 times the largest of 1 m and |lateral_range|",
             });
         }
         Ok(())

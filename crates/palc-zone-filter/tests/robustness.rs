@@ -329,6 +329,22 @@ fn invalid_configs_name_the_field() {
             },
             "tolerance",
         ),
+        // A million cells at most, and a bisection that can reach its tolerance.
+        (
+            BoundsConfig {
+                grid_step: 1e-300,
+                tolerance: 1e-301,
+                ..BoundsConfig::default()
+            },
+            "grid_step",
+        ),
+        (
+            BoundsConfig {
+                tolerance: 1e-17,
+                ..BoundsConfig::default()
+            },
+            "tolerance",
+        ),
     ] {
         let err = lateral_bounds(&model, &[scene(0.0)], &bounds).unwrap_err();
         assert!(
