@@ -285,6 +285,7 @@ impl LearnConfig {
     pub fn validate(&self) -> Result<(), HarnessError> {
         self.traffic.validate()?;
         self.planning.validate()?;
+        self.standard_weights.validate()?;
         self.user.simulated(self.planning.takeover_threshold_m)?;
         let s = &self.stopping;
         for (field, value, max) in [

@@ -11,6 +11,7 @@
 use palc_planner::{FEATURE_COUNT, Weights, feature};
 use serde::{Deserialize, Serialize};
 
+use crate::HarnessError;
 use crate::user::ExpectedLaneChange;
 
 /// Weights of the standard ALC, per stage; defaults in `configs/learn.toml`.
@@ -36,6 +37,31 @@ impl Default for StandardWeights {
 }
 
 impl StandardWeights {
+    /// Checks every weight: the stiffness finite and positive (at zero nothing pulls
+    /// the plan towards a lane change, and the target rule, which moves the target
+    /// `−w2 / (2 w1)`, has nothing to move), heading and steering finite and not
+    /// negative (the cost stays convex).
+    ///
+    /// # Errors
+    /// [`HarnessError::InvalidConfig`] naming the `[standard_weights]` field.
+    pub fn validate(&self) -> Result<(), HarnessError> {
+        let invalid = |field: &str, value: f64, bound: &str| HarnessError::InvalidConfig {
+            field: format!("standard_weights.{field}"),
+            value,
+            bound: bound.to_owned(),
+        };
+        if !(self.lateral_stiffness.is_finite() && self.lateral_stiffness > 0.0) {
+            let value = self.lateral_stiffness;
+            return Err(invalid("lateral_stiffness", value, "a finite value > 0"));
+        }
+        for (field, value) in [("heading", self.heading), ("steering", self.steering)] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(invalid(field, value, "a finite value >= 0"));
+            }
+        }
+        Ok(())
+    }
+
     /// The 10 x K weight matrix whose plan follows `lane_change` (column `c` weighs
     /// the state at step `c`, time `c dt`).
     pub fn weights(&self, lane_change: &ExpectedLaneChange, horizon: usize, dt: f64) -> Weights {

@@ -225,6 +225,15 @@ fn invalid_configs_are_refused_naming_the_field() {
         assert!(err.contains(name), "{err}");
     }
 
+    let mut bad = config(Method::Palc, "neutral");
+    bad.standard_weights.lateral_stiffness = 0.0;
+    let err = run(&bad, None, &mut NoObserver).unwrap_err().to_string();
+    assert!(err.contains("standard_weights.lateral_stiffness"), "{err}");
+    bad.standard_weights.lateral_stiffness = 1.0;
+    bad.standard_weights.steering = f64::NAN;
+    let err = run(&bad, None, &mut NoObserver).unwrap_err().to_string();
+    assert!(err.contains("standard_weights.steering"), "{err}");
+
     // A window of 1e9 s at dt = 0.1 s would be 1e10 steps to allocate.
     let mut bad = config(Method::Palc, "neutral");
     bad.planning.search_window_s = 1e9;
