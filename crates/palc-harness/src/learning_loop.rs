@@ -506,7 +506,7 @@ impl LearningLoop {
             }
         }
         // Whether the lesson shows where the user starts in this scene's gap.
-        let mut onset_seen = user.is_some();
+        let mut onset_seen = true;
         if let (Some(user), true) = (user, self.options.average_lessons) {
             // The expert follows the mean of this scene's lessons (scene_lessons.rs).
             // A lesson in a gap the scene's lane changes do not point to leaves the

@@ -148,7 +148,7 @@ impl PlanningConfig {
     }
 }
 
-fn invalid(field: &str, value: f64, bound: &str) -> HarnessError {
+pub(crate) fn invalid(field: &str, value: f64, bound: &str) -> HarnessError {
     HarnessError::InvalidConfig {
         field: field.to_owned(),
         value,

@@ -12,6 +12,7 @@ use palc_planner::{FEATURE_COUNT, Weights, feature};
 use serde::{Deserialize, Serialize};
 
 use crate::HarnessError;
+use crate::setup::invalid;
 use crate::user::ExpectedLaneChange;
 
 /// Weights of the standard ALC, per stage; defaults in `configs/learn.toml`.
@@ -45,16 +46,15 @@ impl StandardWeights {
     /// # Errors
     /// [`HarnessError::InvalidConfig`] naming the `[standard_weights]` field.
     pub fn validate(&self) -> Result<(), HarnessError> {
-        let invalid = |field: &str, value: f64, bound: &str| HarnessError::InvalidConfig {
-            field: format!("standard_weights.{field}"),
-            value,
-            bound: bound.to_owned(),
-        };
         if !(self.lateral_stiffness.is_finite() && self.lateral_stiffness > 0.0) {
-            let value = self.lateral_stiffness;
-            return Err(invalid("lateral_stiffness", value, "a finite value > 0"));
+            let (field, value) = ("standard_weights.lateral_stiffness", self.lateral_stiffness);
+            return Err(invalid(field, value, "a finite value > 0"));
         }
-        for (field, value) in [("heading", self.heading), ("steering", self.steering)] {
+        let penalties = [
+            ("standard_weights.heading", self.heading),
+            ("standard_weights.steering", self.steering),
+        ];
+        for (field, value) in penalties {
             if !(value.is_finite() && value >= 0.0) {
                 return Err(invalid(field, value, "a finite value >= 0"));
             }
