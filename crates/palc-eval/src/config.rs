@@ -347,12 +347,12 @@ impl EvalConfig {
             if let Some(family) = &user.family {
                 family
                     .validate(&format!("users[{i}].family"))
-                    .map_err(EvalError::invalid_user)?;
+                    .map_err(|e| EvalError::invalid_user(e.into()))?;
             }
             if let Some(parameters) = &user.spread_parameters {
                 parameters
                     .validate(&format!("users[{i}].spread_parameters"))
-                    .map_err(EvalError::invalid_user)?;
+                    .map_err(|e| EvalError::invalid_user(e.into()))?;
             }
             if self.users[..i].iter().any(|u| u.name == user.name) {
                 return Err(EvalError::invalid(

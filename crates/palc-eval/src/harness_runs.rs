@@ -149,10 +149,8 @@ impl Executor for HarnessRuns {
                 let row = row(spec, &result, recorder.iterations, wall_s);
                 (row, Some(result.experience))
             }
-            Err(HarnessError::Scenario { scenario, reason }) => {
-                let status = Status::Refused {
-                    reason: format!("{scenario}: {reason}"),
-                };
+            Err(HarnessError::Refused { scenario, refusal }) => {
+                let status = Status::refused(&scenario, refusal);
                 (
                     RunRow::without_result(spec.clone(), status, cap, wall_s),
                     None,

@@ -232,6 +232,7 @@ pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcom
     };
 
     results::write(&rows, &out.join("runs.json"), &out.join("runs.csv"))?;
+    results::write_refusals(&rows, &out.join("refusals.csv"))?;
     if let Ok(trace) = &example {
         write(
             &out.join("example.json"),

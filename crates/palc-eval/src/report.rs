@@ -302,10 +302,12 @@ fn sensitivity_table(
     let _ = writeln!(out);
 }
 
+/// Refused runs counted by kind and experiment (one line per kind, each with
+/// one example message; every refused run is in `refusals.csv`), then the runs
+/// that stopped on an error.
 fn refusals(out: &mut String, rows: &[RunRow]) {
-    let refused: Vec<&RunRow> = rows
-        .iter()
-        .filter(|r| matches!(r.status, Status::Refused { .. }))
+    let refused: Vec<(String, &RunRow)> = (rows.iter())
+        .filter_map(|r| r.status.refusal_kind().map(|kind| (kind, r)))
         .collect();
     let failed: Vec<&RunRow> = rows
         .iter()
@@ -315,22 +317,54 @@ fn refusals(out: &mut String, rows: &[RunRow]) {
     let _ = writeln!(
         out,
         "{} of {} runs were refused before running (not counted in the statistics above), \
-         {} stopped on an error (counted as failures at the cap).\n",
+         {} stopped on an error (counted as failures at the cap). Every refused run, with its \
+         message, is in `refusals.csv`.\n",
         refused.len(),
         rows.len(),
         failed.len()
     );
-    let mut reasons: Vec<(String, usize)> = Vec::new();
-    for row in &refused {
-        if let Status::Refused { reason } = &row.status {
-            match reasons.iter_mut().find(|(r, _)| r == reason) {
-                Some((_, n)) => *n += 1,
-                None => reasons.push((reason.clone(), 1)),
-            }
+    let mut experiments: Vec<&str> = Vec::new();
+    let mut kinds: Vec<(&str, &str)> = Vec::new();
+    for (kind, row) in &refused {
+        let experiment = row.spec.experiment.name();
+        if !experiments.contains(&experiment) {
+            experiments.push(experiment);
+        }
+        if !kinds.iter().any(|(k, _)| k == kind) {
+            let example = match &row.status {
+                Status::Refused { reason, .. } => reason.as_str(),
+                _ => "",
+            };
+            kinds.push((kind, example));
         }
     }
-    for (reason, n) in reasons {
-        let _ = writeln!(out, "- refused ({n} runs): {reason}");
+    if !kinds.is_empty() {
+        let _ = writeln!(
+            out,
+            "| kind | {} | total | example |",
+            experiments.join(" | ")
+        );
+        let _ = writeln!(out, "|{}", " --- |".repeat(experiments.len() + 3));
+        for (kind, example) in &kinds {
+            let count = |experiment: Option<&str>| {
+                (refused.iter())
+                    .filter(|(k, r)| {
+                        k == kind && experiment.is_none_or(|e| r.spec.experiment.name() == e)
+                    })
+                    .count()
+            };
+            let cells: Vec<String> = (experiments.iter())
+                .map(|e| count(Some(e)).to_string())
+                .collect();
+            let _ = writeln!(
+                out,
+                "| `{kind}` | {} | {} | {} |",
+                cells.join(" | "),
+                count(None),
+                example.replace('|', "\\|")
+            );
+        }
+        let _ = writeln!(out);
     }
     for row in failed {
         if let Status::Failed { error } = &row.status {

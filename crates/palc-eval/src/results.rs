@@ -19,8 +19,13 @@ pub enum Status {
     /// The scenario was refused before running, e.g. because the standard ALC is
     /// not conservative there; named in the report, not counted in statistics.
     Refused {
-        /// Why.
+        /// Why, as the report prints it.
         reason: String,
+        /// The harness's refusal with its fields; `None` for the evaluation's own
+        /// refusal of a run whose source of experience did not end
+        /// ([`NO_EXPERIENCE_SOURCE`]).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        refusal: Option<Refusal>,
     },
     /// The run stopped on an error; counted as a failure at the cap.
     Failed {
@@ -29,7 +34,32 @@ pub enum Status {
     },
 }
 
+/// The kind of the evaluation's own refusal: a transfer or accumulation run whose
+/// source of experience was refused or failed.
+pub const NO_EXPERIENCE_SOURCE: &str = "no-experience-source";
+
 impl Status {
+    /// A refusal by the harness, as `scenario: reason`.
+    pub fn refused(scenario: &str, refusal: Refusal) -> Status {
+        Status::Refused {
+            reason: format!("{scenario}: {refusal}"),
+            refusal: Some(refusal),
+        }
+    }
+
+    /// The refusal's kind ([`Refusal::kind`] or [`NO_EXPERIENCE_SOURCE`]); `None`
+    /// for a run that was not refused.
+    pub fn refusal_kind(&self) -> Option<String> {
+        match self {
+            Status::Refused {
+                refusal: Some(refusal),
+                ..
+            } => Some(refusal.kind()),
+            Status::Refused { refusal: None, .. } => Some(NO_EXPERIENCE_SOURCE.to_owned()),
+            _ => None,
+        }
+    }
+
     /// Name in CSV.
     pub fn name(&self) -> &'static str {
         match self {
@@ -77,7 +107,7 @@ pub struct Iteration {
     pub closed_loop: Option<ClosedLoopStats>,
 }
 
-use palc_harness::{ClosedLoopStats, FrozenEvaluation, SafetyMetrics, Violation};
+use palc_harness::{ClosedLoopStats, FrozenEvaluation, Refusal, SafetyMetrics, Violation};
 
 /// Names of the parts of [`Iteration::times_s`].
 pub const PART_NAMES: [&str; 5] = palc_harness::Timings::PART_NAMES;
@@ -190,6 +220,47 @@ impl RunRow {
     }
 }
 
+/// Writes `refusals.csv`: one line per refused run, with its kind and message
+/// (REPORT.md counts them by kind and experiment).
+pub fn write_refusals(rows: &[RunRow], path: &Path) -> Result<(), EvalError> {
+    let mut bytes = Vec::new();
+    let mut writer = csv::Writer::from_writer(&mut bytes);
+    writer.write_record([
+        "id",
+        "experiment",
+        "method",
+        "user",
+        "style",
+        "speed_case",
+        "headway_m",
+        "seed",
+        "kind",
+        "reason",
+    ])?;
+    for row in rows {
+        let (Some(kind), Status::Refused { reason, .. }) = (row.status.refusal_kind(), &row.status)
+        else {
+            continue;
+        };
+        writer.write_record([
+            row.spec.id.to_string().as_str(),
+            row.spec.experiment.name(),
+            row.spec.method.name(),
+            &row.spec.user.name,
+            row.spec.style.name(),
+            &row.spec.speed_case.name,
+            &row.spec.headway_m.to_string(),
+            &row.spec.seed.to_string(),
+            &kind,
+            reason,
+        ])?;
+    }
+    writer.flush().map_err(csv::Error::from)?;
+    drop(writer);
+    palc_aggregator::output::write(path, &bytes)?;
+    Ok(())
+}
+
 /// One line of `runs.csv`.
 #[derive(Debug, Serialize)]
 struct CsvRow<'a> {
@@ -206,6 +277,7 @@ struct CsvRow<'a> {
     dt_s: Option<f64>,
     horizon: usize,
     outcome: &'a str,
+    refusal_kind: Option<String>,
     takeovers: usize,
     lane_changes: usize,
     final_max_deviation_m: Option<f64>,
@@ -235,7 +307,7 @@ pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> Result<(), EvalEr
     let mut writer = csv::Writer::from_writer(&mut bytes);
     for row in rows {
         let note = match &row.status {
-            Status::Refused { reason } => reason.clone(),
+            Status::Refused { reason, .. } => reason.clone(),
             Status::Failed { error } => error.clone(),
             _ => String::new(),
         };
@@ -253,6 +325,7 @@ pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> Result<(), EvalEr
             dt_s: row.dt,
             horizon: row.horizon,
             outcome: row.status.name(),
+            refusal_kind: row.status.refusal_kind(),
             takeovers: row.counted_takeovers(),
             lane_changes: row.lane_changes,
             final_max_deviation_m: row.final_max_deviation_m,

@@ -119,7 +119,10 @@ pub fn execute<E: Executor>(
                             let reason = format!("no experience to start from: source run {from}");
                             let row = RunRow::without_result(
                                 (*spec).clone(),
-                                Status::Refused { reason },
+                                Status::Refused {
+                                    reason,
+                                    refusal: None,
+                                },
                                 executor.cap(),
                                 0.0,
                             );
@@ -189,6 +192,7 @@ pub(crate) mod tests {
                             spec.clone(),
                             Status::Refused {
                                 reason: "the standard ALC is not conservative".into(),
+                                refusal: None,
                             },
                             30,
                             0.0,
@@ -294,7 +298,7 @@ pub(crate) mod tests {
                     row.spec.label()
                 );
             } else {
-                let Status::Refused { reason } = &row.status else {
+                let Status::Refused { reason, .. } = &row.status else {
                     panic!("{:?}", row.status)
                 };
                 assert!(reason.contains(&source.spec.label()), "{reason}");
@@ -314,7 +318,7 @@ pub(crate) mod tests {
         for row in transfer {
             let source = &rows[row.spec.experience_from.unwrap()];
             if !source.status.counted() {
-                let Status::Refused { reason } = &row.status else {
+                let Status::Refused { reason, .. } = &row.status else {
                     panic!("{:?}", row.status)
                 };
                 assert!(reason.contains(&source.spec.label()), "{reason}");

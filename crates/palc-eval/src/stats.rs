@@ -505,6 +505,7 @@ mod tests {
         // The third transfer run is refused: it and its grid run leave the pairs.
         transfer[2].status = Status::Refused {
             reason: "no experience".into(),
+            refusal: None,
         };
         grid[2].spec.id = 2;
         let rows: Vec<&RunRow> = grid.iter().chain(&transfer).collect();
@@ -529,7 +530,10 @@ mod tests {
         rows[1].final_takeover_rate = Some(0.4);
         rows[1].ceiling_takeover_rate = Some(0.3);
         // A refused run's rates, were there any, would not count.
-        rows[2].status = Status::Refused { reason: "x".into() };
+        rows[2].status = Status::Refused {
+            reason: "x".into(),
+            refusal: None,
+        };
         rows[2].final_takeover_rate = Some(1.0);
         rows[2].ceiling_takeover_rate = Some(1.0);
         let refs: Vec<&RunRow> = rows.iter().collect();
@@ -562,7 +566,10 @@ mod tests {
         picked[1].status = Status::CapReached;
         picked[1].takeovers = 30;
         picked[1].cap = 30;
-        picked[2].status = Status::Refused { reason: "x".into() };
+        picked[2].status = Status::Refused {
+            reason: "x".into(),
+            refusal: None,
+        };
         let summary = Summary::of(&picked);
         assert_eq!(
             (summary.runs, summary.refused, summary.personalized),

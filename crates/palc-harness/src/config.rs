@@ -8,7 +8,7 @@ use crate::HarnessError;
 use crate::method::Method;
 use crate::setup::PlanningConfig;
 use crate::standard_alc::StandardWeights;
-use crate::user::{Family, SimulatedUser, Spread, Style, StylePreset};
+use palc_user::{Family, SimulatedUser, Spread, Style, StylePreset};
 
 /// Everything that describes one run of the lesson-learning loop.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -110,7 +110,13 @@ impl UserConfig {
             }
             _ => self.style.to_string(),
         };
-        SimulatedUser::new(name, self.style()?, family, deviation_m, self.spread)
+        Ok(SimulatedUser::new(
+            name,
+            self.style()?,
+            family,
+            deviation_m,
+            self.spread,
+        )?)
     }
 
     /// The nominal style of this user.
@@ -333,7 +339,10 @@ impl LearnConfig {
             .ok_or_else(|| {
                 let mut names = names.clone();
                 names.dedup();
-                HarnessError::UnknownSpeedCase(self.cell.speed_case.clone(), names.join(", "))
+                HarnessError::UnknownSpeedCase {
+                    name: self.cell.speed_case.clone(),
+                    defined: names.join(", "),
+                }
             })?;
         if !(self.cell.headway_m.is_finite() && self.cell.headway_m > 0.0) {
             return Err(HarnessError::InvalidConfig {

@@ -9,7 +9,7 @@ use crate::guard::{drive_states, guarded_step, guarded_user_acceleration};
 use crate::record::Takeover;
 use crate::safety::{SafetyMetrics, SafetyMonitor};
 use crate::setup::{Setup, situation, target_gaps_safe};
-use crate::user::{Expectation, ExpectedLaneChange, TakeoverCause, User, max_deviation};
+use palc_user::{Expectation, ExpectedLaneChange, TakeoverCause, User, max_deviation};
 
 /// The planning problem of this scenario with the given weights and lateral bounds.
 ///

@@ -1,6 +1,10 @@
-//! Errors of the harness.
+//! Errors of the harness: an invalid config, a refused scenario ([`Refusal`]),
+//! and the errors of the crates below, each wrapped once.
 
+use palc_user::UserError;
 use thiserror::Error;
+
+use crate::refusal::Refusal;
 
 /// What can go wrong while setting up or running the lesson-learning loop.
 #[derive(Debug, Error)]
@@ -33,15 +37,31 @@ pub enum HarnessError {
         expected: String,
     },
     /// A speed case that the scenario config does not define.
-    #[error("unknown speed case `{0}`: the scenario config defines {1}")]
-    UnknownSpeedCase(String, String),
+    #[error("unknown speed case `{name}`: the scenario config defines {defined}")]
+    UnknownSpeedCase {
+        /// The name found.
+        name: String,
+        /// The speed cases the config defines, quoted.
+        defined: String,
+    },
     /// The scenario does not fit the planning set-up (e.g. a user who never starts).
-    #[error("scenario {scenario}: {reason}")]
-    Scenario {
-        /// Which grid cell.
+    #[error("scenario {scenario}: {refusal}")]
+    Refused {
+        /// Which scenario, e.g. `collector-high / 40 m / seed 1 / neutral`.
         scenario: String,
         /// What does not hold.
-        reason: String,
+        refusal: Refusal,
+    },
+    /// A user of an embedder's own failed.
+    #[error("scenario {scenario}: user `{user}` failed")]
+    UserFailed {
+        /// Which scenario.
+        scenario: String,
+        /// The user's name.
+        user: String,
+        /// What failed.
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
     },
     /// The TOML text does not parse or does not match the schema (unknown field, missing
     /// field, wrong type); the message names the field path, the line and the column.
@@ -69,6 +89,58 @@ pub enum HarnessError {
     /// An error of the aggregator.
     #[error(transparent)]
     Aggregator(#[from] palc_aggregator::AggregatorError),
+}
+
+impl HarnessError {
+    /// A user's error in `scenario`: its refusal becomes [`HarnessError::Refused`],
+    /// its config errors keep their field.
+    pub fn from_user(scenario: &str, error: UserError) -> HarnessError {
+        match error {
+            UserError::InvalidConfig {
+                field,
+                value,
+                bound,
+            } => HarnessError::InvalidConfig {
+                field,
+                value,
+                bound,
+            },
+            UserError::UnknownStyle { name, expected } => {
+                HarnessError::UnknownStyle { name, expected }
+            }
+            UserError::Refused { user, refusal } => HarnessError::Refused {
+                scenario: scenario.to_owned(),
+                refusal: Refusal::User { user, refusal },
+            },
+            UserError::Failed { user, source } => HarnessError::UserFailed {
+                scenario: scenario.to_owned(),
+                user,
+                source,
+            },
+            other => HarnessError::UserFailed {
+                scenario: scenario.to_owned(),
+                user: String::new(),
+                source: Box::new(other),
+            },
+        }
+    }
+}
+
+impl From<UserError> for HarnessError {
+    /// A user's config error keeps its field (a user's checks refuse only in a
+    /// scenario, through [`HarnessError::from_user`]).
+    fn from(error: UserError) -> Self {
+        HarnessError::from_user("", error)
+    }
+}
+
+/// The error of a config field out of its bound.
+pub(crate) fn invalid(field: &str, value: f64, bound: &str) -> HarnessError {
+    HarnessError::InvalidConfig {
+        field: field.to_owned(),
+        value,
+        bound: bound.to_owned(),
+    }
 }
 
 /// `` `path`: `` before a message, or nothing for an empty path.

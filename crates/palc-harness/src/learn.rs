@@ -12,8 +12,9 @@ use crate::learning_loop::LearningLoop;
 use crate::method::Method;
 use crate::observer::Observer;
 use crate::record::{LaneChangeRecord, RunSummary};
+use crate::refusal::Refusal;
 use crate::setup::Setup;
-use crate::user::{Expectation, StylePreset, User};
+use palc_user::{Expectation, StylePreset, User};
 
 /// Everything a run produced.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -52,9 +53,9 @@ pub fn prepare(config: &LearnConfig) -> Result<Setup, HarnessError> {
     let setup = Setup::new(&scene, &config.planning, &label)?;
     setup
         .check_conservative(&config.planning.standard_alc, &StylePreset::ALL)
-        .map_err(|reason| HarnessError::Scenario {
+        .map_err(|refusal: Refusal| HarnessError::Refused {
             scenario: label,
-            reason,
+            refusal,
         })?;
     Ok(setup)
 }
@@ -79,7 +80,8 @@ pub(crate) fn prepare_for(
     user: &dyn User,
 ) -> Result<(Setup, Expectation), HarnessError> {
     let mut setup = prepare(config)?;
-    let nominal = user.nominal(&setup)?;
+    let nominal = (user.nominal(&setup.user_scene()))
+        .map_err(|error| HarnessError::from_user(&setup.label, error))?;
     setup.cover(
         nominal.lane_change.end_s(),
         config.planning.horizon_margin_s,

@@ -25,10 +25,11 @@ use crate::method::Method;
 use crate::observer::{LessonEvent, Observer};
 use crate::onset::{UserLaneChange, onset_at};
 use crate::record::{FrozenEvaluation, LaneChangeRecord, Outcome, RunSummary};
+use crate::refusal::Refusal;
 use crate::safety::{SafetyMetrics, Violation};
 use crate::scene_lessons::SceneLessons;
 use crate::setup::Setup;
-use crate::user::{Expectation, User};
+use palc_user::{Expectation, User};
 
 /// One run of the lesson-learning loop (paper Fig. 2): plan with the experience,
 /// let the simulated user judge the lane change, and on a takeover label the lesson,
@@ -87,7 +88,7 @@ impl LearningLoop {
     ///
     /// # Errors
     /// Invalid config or options, a scenario the paper's premise does not hold in
-    /// ([`HarnessError::Scenario`]), a user without a sane lane change in it, or a
+    /// ([`HarnessError::Refused`]), a user without a sane lane change in it, or a
     /// first plan that cannot be solved.
     pub fn new(
         config: &LearnConfig,
@@ -120,12 +121,13 @@ impl LearningLoop {
             &nominal,
             &nominal.states[..=setup.horizon],
         )? {
-            return Err(HarnessError::Scenario {
+            return Err(HarnessError::Refused {
                 scenario: config.label(),
-                reason: format!(
-                    "user `{}` would take over its own lane change at step {step} ({cause:?})",
-                    user.name()
-                ),
+                refusal: Refusal::OwnLaneChangeTakenOver {
+                    user: user.name().to_owned(),
+                    step,
+                    cause,
+                },
             });
         }
         // Under the longitudinal guard, the user's own lane change driven in the
@@ -135,13 +137,12 @@ impl LearningLoop {
         if setup.acc.guard {
             let own = states_safety(&setup, &nominal.states[..=setup.horizon])?;
             if own.collision {
-                return Err(HarnessError::Scenario {
+                return Err(HarnessError::Refused {
                     scenario: config.label(),
-                    reason: format!(
-                        "the lane change user `{}` expects collides in this scene ({})",
-                        user.name(),
-                        collided_with(&own)
-                    ),
+                    refusal: Refusal::OwnLaneChangeCollides {
+                        user: user.name().to_owned(),
+                        vehicles: collided_with(&own),
+                    },
                 });
             }
         }
@@ -149,12 +150,12 @@ impl LearningLoop {
         // target lane beside a vehicle of it: the user would hold there, so it
         // would take over any other plan and then teach a hold it does not expect.
         if let Some(step) = own_lane_change_enters_beside(&setup, user.as_ref(), &nominal)? {
-            return Err(HarnessError::Scenario {
+            return Err(HarnessError::Refused {
                 scenario: config.label(),
-                reason: format!(
-                    "user `{}` would hold its own lane change beside a target-lane vehicle at step {step}",
-                    user.name()
-                ),
+                refusal: Refusal::OwnLaneChangeEntersBeside {
+                    user: user.name().to_owned(),
+                    step,
+                },
             });
         }
         let options = aggregator_options(config);
@@ -178,11 +179,9 @@ impl LearningLoop {
             let plan = planner.plan(&problem(&setup, standard_weights, Vec::new()))?;
             let safety = plan_safety(&setup, &plan)?;
             if let Some(violation) = safety.first_violation {
-                return Err(HarnessError::Scenario {
+                return Err(HarnessError::Refused {
                     scenario: config.label(),
-                    reason: format!(
-                        "no safe lane change: the standard ALC's plan is refused ({violation})"
-                    ),
+                    refusal: Refusal::StandardPlanUnsafe { violation },
                 });
             }
             Some((plan, safety))
@@ -404,17 +403,18 @@ impl LearningLoop {
     /// drives `plan` in the scene, and judges the nominal lane change against the
     /// same draw (the ceiling).
     fn drive(&mut self, plan: Plan) -> Result<(Drive, bool), HarnessError> {
-        let expectation = self.user.next(&self.setup)?;
+        let expectation = (self.user.next(&self.setup.user_scene()))
+            .map_err(|error| HarnessError::from_user(&self.label, error))?;
         let horizon_s = self.setup.horizon as f64 * self.setup.dt;
         if expectation.lane_change.end_s() > horizon_s + 1e-9 {
-            return Err(HarnessError::Scenario {
+            return Err(HarnessError::Refused {
                 scenario: self.label.clone(),
-                reason: format!(
-                    "a drawn lane change of user `{}` (start {:.3} s, duration {:.3} s) ends after the {horizon_s:.2} s horizon",
-                    self.user.name(),
-                    expectation.lane_change.start_s,
-                    expectation.lane_change.duration_s
-                ),
+                refusal: Refusal::DrawBeyondHorizon {
+                    user: self.user.name().to_owned(),
+                    start_s: expectation.lane_change.start_s,
+                    duration_s: expectation.lane_change.duration_s,
+                    horizon_s,
+                },
             });
         }
         let ceiling = if self.user.has_spread() {

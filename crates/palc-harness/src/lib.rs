@@ -44,11 +44,15 @@ mod method;
 mod observer;
 mod onset;
 mod record;
+mod refusal;
 pub mod safety;
 mod scene_lessons;
 mod setup;
 mod standard_alc;
-pub mod user;
+
+/// The users: the [`User`] trait, its plain view of a scenario and the built-in
+/// simulated users (the `palc-user` crate).
+pub use palc_user as user;
 
 pub use acc::AccConfig;
 pub use closed_loop::{ClosedLoopConfig, ClosedLoopStats};
@@ -62,12 +66,12 @@ pub use learning_loop::LearningLoop;
 pub use method::Method;
 pub use observer::{LessonEvent, NoObserver, Observer};
 pub use palc_aggregator::Timings;
+pub use palc_user::{Family, SimulatedUser, StylePreset, User, UserScene};
 pub use record::{FrozenEvaluation, LaneChangeRecord, Outcome, RunSummary, Takeover};
+pub use refusal::Refusal;
 pub use safety::{SafetyConfig, SafetyMetrics, SafetyMonitor, Violation};
 pub use setup::{PlanningConfig, Setup};
 pub use standard_alc::StandardWeights;
-pub use user::StylePreset;
-pub use user::{Family, SimulatedUser, User};
 
 /// The loop's building blocks, for those who drive their own loop or test one
 /// part of it: the planning problem of a scenario, the execution of a plan with a

@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::closed_loop::ClosedLoopStats;
 use crate::safety::{SafetyMetrics, Violation};
-use crate::user::TakeoverCause;
+use palc_user::TakeoverCause;
 
 /// Where and how the user took over.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

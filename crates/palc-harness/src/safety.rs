@@ -101,14 +101,17 @@ impl SafetyConfig {
 
     /// The RSS safe distance (m) of a rear vehicle at `rear_v` behind a front one at `front_v`.
     pub fn safe_distance(&self, rear_v: f64, front_v: f64) -> f64 {
-        let rho = self.response_time_s;
-        let a = self.max_acceleration_mps2;
-        let after_response = rear_v + rho * a;
-        let d = rear_v * rho
-            + 0.5 * a * rho * rho
-            + after_response * after_response / (2.0 * self.min_braking_mps2)
-            - front_v * front_v / (2.0 * self.max_braking_mps2);
-        d.max(0.0)
+        self.rss().distance(rear_v, front_v)
+    }
+
+    /// The RSS parameters, as a user sees them ([`palc_user::SafeDistance`]).
+    pub fn rss(&self) -> palc_user::SafeDistance {
+        palc_user::SafeDistance {
+            response_time_s: self.response_time_s,
+            max_acceleration_mps2: self.max_acceleration_mps2,
+            min_braking_mps2: self.min_braking_mps2,
+            max_braking_mps2: self.max_braking_mps2,
+        }
     }
 }
 

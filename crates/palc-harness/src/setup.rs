@@ -16,7 +16,10 @@ use crate::HarnessError;
 use crate::acc::{AccConfig, acc_leader};
 use crate::closed_loop::ClosedLoopConfig;
 use crate::safety::SafetyConfig;
-use crate::user::{ExpectedLaneChange, Situation, Style, StylePreset};
+use palc_user::{ExpectedLaneChange, Situation, Style, StylePreset, UserScene};
+
+use crate::error::invalid;
+use crate::refusal::Refusal;
 
 /// Parameters of the planning set-up; defaults in `configs/learn.toml`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -148,14 +151,6 @@ impl PlanningConfig {
     }
 }
 
-pub(crate) fn invalid(field: &str, value: f64, bound: &str) -> HarnessError {
-    HarnessError::InvalidConfig {
-        field: field.to_owned(),
-        value,
-        bound: bound.to_owned(),
-    }
-}
-
 /// Everything the loop needs about one scenario, computed once at the trigger.
 #[derive(Debug, Clone)]
 pub struct Setup {
@@ -209,23 +204,19 @@ impl Setup {
     /// the scene over the search window, the ego still keeping its lane under its ACC.
     pub fn new(scene: &Scene, config: &PlanningConfig, label: &str) -> Result<Setup, HarnessError> {
         config.validate()?;
-        let scenario_error = |reason: String| HarnessError::Scenario {
+        let refused = |refusal: Refusal| HarnessError::Refused {
             scenario: label.to_owned(),
-            reason,
+            refusal,
         };
-        let ego = scene
-            .ego()
-            .ok_or_else(|| scenario_error("the scene has no ego vehicle".to_owned()))?;
+        let ego = scene.ego().ok_or_else(|| refused(Refusal::NoEgo))?;
         let set_speed = ego.state.v;
         if set_speed.is_nan() || set_speed <= 0.0 {
-            return Err(scenario_error(format!(
-                "the ego speed is {set_speed} m/s, expected > 0"
-            )));
+            return Err(refused(Refusal::EgoNotMoving {
+                speed_mps: set_speed,
+            }));
         }
         if scene.preceding().is_none() {
-            return Err(scenario_error(
-                "the scene has no preceding vehicle".to_owned(),
-            ));
+            return Err(refused(Refusal::NoPreceding));
         }
 
         let mut scene = scene.clone();
@@ -239,18 +230,18 @@ impl Setup {
             lane_keeping_step(&mut scene, config, set_speed, None)?;
         }
         if trigger.is_none() {
-            return Err(scenario_error(format!(
-                "the time headway never falls to the trigger {} s within {} s",
-                config.trigger_time_headway_s, config.max_approach_s
-            )));
+            return Err(refused(Refusal::NeverTriggers {
+                trigger_time_headway_s: config.trigger_time_headway_s,
+                max_approach_s: config.max_approach_s,
+            }));
         }
         let trigger_time_s = scene.time();
         let origin_s = scene.ego().map_or(0.0, |e| e.state.s);
         let ego_speed = scene.ego().map_or(set_speed, |e| e.state.v);
         if ego_speed <= 0.0 {
-            return Err(scenario_error(format!(
-                "the ego has stopped behind the preceding vehicle before the trigger (speed {ego_speed:?} m/s)"
-            )));
+            return Err(refused(Refusal::StoppedBeforeTrigger {
+                speed_mps: ego_speed,
+            }));
         }
 
         let window = (config.search_window_s / config.dt).ceil() as usize;
@@ -295,18 +286,17 @@ impl Setup {
 
         let standard = &config.standard_alc;
         let own_start = standard.start_step(&situations).ok_or_else(|| {
-            scenario_error(format!(
-                "the standard ALC never starts within the {} s search window",
-                config.search_window_s
-            ))
+            refused(Refusal::StandardNeverStarts {
+                window_s: config.search_window_s,
+            })
         })?;
         let mut latest_user = 0;
         for style in StylePreset::ALL.map(StylePreset::style) {
             let start = style.start_step(&situations).ok_or_else(|| {
-                scenario_error(format!(
-                    "a user ({} s headway) never starts within the {} s search window",
-                    style.time_headway_s, config.search_window_s
-                ))
+                refused(Refusal::StyleNeverStarts {
+                    time_headway_s: style.time_headway_s,
+                    window_s: config.search_window_s,
+                })
             })?;
             latest_user = latest_user.max(start);
         }
@@ -323,32 +313,30 @@ impl Setup {
                             .is_some_and(|w| w.iter().all(|s| target_gaps_safe(s, &config.safety))))
             })
             .ok_or_else(|| {
-                let reason = if config.safety.enforce {
-                    "the target-lane gaps stay below the safe distance".to_owned()
+                let (duration_s, window_s) =
+                    (standard.lane_change_duration_s, config.search_window_s);
+                refused(if config.safety.enforce {
+                    Refusal::StandardGapsUnsafe {
+                        duration_s,
+                        window_s,
+                    }
                 } else {
-                    format!(
-                        "the ego has reached the preceding vehicle (time headway {:.2} s) when \
-                         the standard ALC would start, {} steps after the latest user",
-                        situations
+                    Refusal::StandardBehindPreceding {
+                        duration_s,
+                        window_s,
+                        time_headway_s: situations
                             .get(earliest)
                             .map_or(f64::NAN, |s| s.time_headway_s),
-                        delay
-                    )
-                };
-                scenario_error(format!(
-                    "no safe lane change for the standard ALC's {} s lane change within the \
-                     {} s search window: {reason}",
-                    standard.lane_change_duration_s, config.search_window_s
-                ))
+                        delay_steps: delay,
+                    }
+                })
             })?;
         let end_s = standard_start_step as f64 * config.dt
             + standard.lane_change_duration_s
             + config.horizon_margin_s;
         let horizon = (end_s / config.dt).ceil() as usize;
         if horizon > window {
-            return Err(scenario_error(format!(
-                "the horizon ({horizon} steps) exceeds the search window ({window} steps)"
-            )));
+            return Err(refused(Refusal::HorizonBeyondWindow { horizon, window }));
         }
         Ok(Setup {
             label: label.to_owned(),
@@ -370,6 +358,18 @@ impl Setup {
             gap_seeking_from,
             target_l: config.target_l,
         })
+    }
+
+    /// The scenario as a user sees it: plain numbers, no harness types.
+    pub fn user_scene(&self) -> UserScene<'_> {
+        UserScene {
+            dt: self.dt,
+            situations: &self.situations,
+            lane_keeping: &self.lane_keeping,
+            set_speed: self.set_speed,
+            target_l: self.target_l,
+            safe_gaps: (self.safety.users_wait_for_safe_gaps).then(|| self.safety.rss()),
+        }
     }
 
     /// The lane change a user of `style` expects in this scenario, or `None` when
@@ -416,17 +416,18 @@ impl Setup {
     /// `margin_s` (a user who changes lanes after the standard ALC). Never shortens it.
     ///
     /// # Errors
-    /// [`HarnessError::Scenario`] when that horizon exceeds the search window.
+    /// [`HarnessError::Refused`] when that horizon exceeds the search window.
     pub fn cover(&mut self, end_s: f64, margin_s: f64) -> Result<(), HarnessError> {
         let needed = ((end_s + margin_s) / self.dt - 1e-9).ceil().max(0.0) as usize;
         let window = self.situations.len().saturating_sub(1);
         if needed > window {
-            return Err(HarnessError::Scenario {
+            return Err(HarnessError::Refused {
                 scenario: self.label.clone(),
-                reason: format!(
-                    "a lane change ending at {end_s:.2} s needs a horizon of {needed} steps, \
-                     beyond the search window ({window} steps)"
-                ),
+                refusal: Refusal::LaneChangeBeyondWindow {
+                    end_s,
+                    needed,
+                    window,
+                },
             });
         }
         self.horizon = self.horizon.max(needed);
@@ -439,26 +440,26 @@ impl Setup {
         &self,
         standard: &Style,
         styles: &[StylePreset],
-    ) -> Result<(), String> {
+    ) -> Result<(), Refusal> {
         let standard_start = self.standard_start_step as f64 * self.dt;
         for preset in styles {
-            let (name, style) = (preset.name(), preset.style());
+            let (name, style) = (preset.name().to_owned(), preset.style());
             let Some(expected) = self.expected(&style) else {
-                return Err(format!(
-                    "the {name} user does not change lanes within the horizon"
-                ));
+                return Err(Refusal::StyleNotWithinHorizon { style: name });
             };
             if expected.start_s >= standard_start {
-                return Err(format!(
-                    "the standard ALC starts at {standard_start:.2} s, not later than the {name} user ({:.2} s)",
-                    expected.start_s
-                ));
+                return Err(Refusal::StandardNotLater {
+                    standard_start_s: standard_start,
+                    style: name,
+                    user_start_s: expected.start_s,
+                });
             }
             if style.lane_change_duration_s >= standard.lane_change_duration_s {
-                return Err(format!(
-                    "the standard ALC's lane change ({} s) is not slower than the {name} user's ({} s)",
-                    standard.lane_change_duration_s, style.lane_change_duration_s
-                ));
+                return Err(Refusal::StandardNotSlower {
+                    standard_duration_s: standard.lane_change_duration_s,
+                    style: name,
+                    user_duration_s: style.lane_change_duration_s,
+                });
             }
         }
         Ok(())
@@ -468,16 +469,7 @@ impl Setup {
 /// Whether both target-lane gaps in `situation` are at least the safe distance:
 /// the ego behind the lead, the lag behind the ego.
 pub(crate) fn target_gaps_safe(situation: &Situation, safety: &SafetyConfig) -> bool {
-    let v = situation.ego_speed;
-    let lead_ok = match (situation.target_lead_gap_m, situation.target_lead_speed) {
-        (Some(gap), Some(lead_v)) => gap >= safety.safe_distance(v, lead_v),
-        _ => true,
-    };
-    let lag_ok = match (situation.target_lag_gap_m, situation.target_lag_speed) {
-        (Some(gap), Some(lag_v)) => gap >= safety.safe_distance(lag_v, v),
-        _ => true,
-    };
-    lead_ok && lag_ok
+    safety.rss().target_gaps_safe(situation)
 }
 
 /// The acceleration of the ego keeping its lane under its ACC; when seeking a gap

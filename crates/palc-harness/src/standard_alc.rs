@@ -12,8 +12,8 @@ use palc_planner::{FEATURE_COUNT, Weights, feature};
 use serde::{Deserialize, Serialize};
 
 use crate::HarnessError;
-use crate::setup::invalid;
-use crate::user::ExpectedLaneChange;
+use crate::error::invalid;
+use palc_user::ExpectedLaneChange;
 
 /// Weights of the standard ALC, per stage; defaults in `configs/learn.toml`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -93,7 +93,7 @@ fn with_exact_predictions_the_closed_loop_sees_the_open_loop_takeover() {
     let (setup, experience, options, planner, _, plan) = standard_plan();
     let k = setup.horizon;
     let user = SimulatedUser::paper(StylePreset::Aggressive.style()).unwrap();
-    let expected = user.nominal(&setup).unwrap();
+    let expected = user.nominal(&setup.user_scene()).unwrap();
 
     let open = execute(&setup, plan.clone(), &user, &expected).unwrap();
     let driver = ClosedLoop::new(planner, 1, None).unwrap();

@@ -79,7 +79,7 @@ fn run_or_refused(
 ) -> Option<RunResult> {
     match run(config, experience, &mut NoObserver) {
         Ok(result) => Some(result),
-        Err(HarnessError::Scenario { .. }) => None,
+        Err(HarnessError::Refused { .. }) => None,
         Err(other) => panic!("{other}"),
     }
 }

@@ -29,7 +29,7 @@ proptest! {
         }).unwrap();
         let plan = planner.plan(&problem(&setup, weights, Vec::new())).unwrap();
         let user = SimulatedUser::paper(Style::NEUTRAL).unwrap();
-        let mut expectation = user.nominal(&setup).unwrap();
+        let mut expectation = user.nominal(&setup.user_scene()).unwrap();
         expectation.lane_change = ExpectedLaneChange::quintic(start, duration, 0.0, 3.5);
         for (i, state) in expectation.states.iter_mut().enumerate() {
             state.l = expectation.lane_change.lateral(i as f64 * setup.dt);

@@ -4,12 +4,13 @@
 //! smooth, and starts as the family's start rule says; invalid parameters name
 //! their field; and a user defined outside the harness runs in the loop.
 
+use palc_harness::user::ExpectedLaneChange;
 use palc_harness::user::{
     Expectation, Family, LateralProfile, MAX_LATERAL_ACCELERATION_MPS2, MAX_LATERAL_JERK_MPS3,
     PerceivedSafety, ProfilePoint, SimulatedUser, SpeedRule, StartRule, Style, StylePreset, User,
-    quintic,
+    UserError, UserScene, quintic,
 };
-use palc_harness::{HarnessError, LearnConfig, LearningLoop, NoObserver, Outcome, Setup, prepare};
+use palc_harness::{LearnConfig, LearningLoop, NoObserver, Outcome, Setup, prepare};
 use proptest::prelude::*;
 
 fn base() -> LearnConfig {
@@ -130,11 +131,11 @@ proptest! {
         family.validate("user.family").unwrap();
         let user = SimulatedUser::new("probe", style, family.clone(), 0.3, None).unwrap();
         let setup = setup(speed_case, headway);
-        match user.nominal(&setup) {
+        match user.nominal(&setup.user_scene()) {
             Ok(expectation) => check(&expectation, &setup, &family, &style),
-            Err(HarnessError::Scenario { scenario, reason }) => {
-                prop_assert_eq!(scenario, setup.label.clone());
-                prop_assert!(reason.starts_with("user `probe`: "), "{}", reason);
+            Err(UserError::Refused { user, refusal }) => {
+                prop_assert_eq!(user, "probe");
+                prop_assert!(!refusal.to_string().is_empty());
             }
             Err(other) => prop_assert!(false, "unexpected error {other}"),
         }
@@ -148,7 +149,7 @@ fn the_paper_user_is_the_default_family() {
     for preset in StylePreset::ALL {
         let style = preset.style();
         let user = SimulatedUser::paper(style).unwrap();
-        let expectation = user.nominal(&setup).unwrap();
+        let expectation = user.nominal(&setup.user_scene()).unwrap();
         let paper = setup.expected(&style).unwrap();
         assert_eq!(expectation.lane_change, paper);
         assert_eq!(
@@ -196,7 +197,7 @@ fn most_plausible_families_are_accepted_in_the_grid() {
             let user =
                 SimulatedUser::new("probe", Style::NEUTRAL, family.clone(), 0.3, None).unwrap();
             let expectation = user
-                .nominal(&setup)
+                .nominal(&setup.user_scene())
                 .unwrap_or_else(|e| panic!("{case}, {}: {e}", family.describe()));
             check(&expectation, &setup, &family, &Style::NEUTRAL);
         }
@@ -243,10 +244,12 @@ fn invalid_user_tables_name_the_field_value_and_bound() {
 }
 
 /// A user defined outside the harness: it expects the standard ALC's own lane
-/// change, so the system's very first plan satisfies it.
+/// change (told to it once, as a recorded driver is given its trace), so the
+/// system's very first plan satisfies it.
 #[derive(Debug)]
 struct LikesTheStandardAlc {
-    standard: Style,
+    lane_change: ExpectedLaneChange,
+    start_step: usize,
 }
 
 impl User for LikesTheStandardAlc {
@@ -254,27 +257,29 @@ impl User for LikesTheStandardAlc {
         "likes the standard ALC"
     }
 
-    fn nominal(&self, setup: &Setup) -> Result<Expectation, HarnessError> {
+    fn nominal(&self, scene: &UserScene<'_>) -> Result<Expectation, UserError> {
         let paper = SimulatedUser::paper(Style::NEUTRAL)?;
-        let mut expectation = paper.nominal(setup)?;
-        expectation.lane_change = setup.standard_lane_change(&self.standard);
-        expectation.start_step = setup.standard_start_step;
+        let mut expectation = paper.nominal(scene)?;
+        expectation.lane_change = self.lane_change.clone();
+        expectation.start_step = self.start_step;
         for (i, state) in expectation.states.iter_mut().enumerate() {
-            state.l = expectation.lane_change.lateral(i as f64 * setup.dt);
+            state.l = expectation.lane_change.lateral(i as f64 * scene.dt);
         }
         Ok(expectation)
     }
 
-    fn next(&mut self, setup: &Setup) -> Result<Expectation, HarnessError> {
-        self.nominal(setup)
+    fn next(&mut self, scene: &UserScene<'_>) -> Result<Expectation, UserError> {
+        self.nominal(scene)
     }
 }
 
 #[test]
 fn a_user_from_outside_the_harness_plugs_into_the_loop() {
     let config = base();
+    let setup = prepare(&config).unwrap();
     let user = LikesTheStandardAlc {
-        standard: config.planning.standard_alc,
+        lane_change: setup.standard_lane_change(&config.planning.standard_alc),
+        start_step: setup.standard_start_step,
     };
     let run = LearningLoop::with_user(&config, None, Box::new(user)).unwrap();
     let result = run.run(&mut NoObserver).unwrap();

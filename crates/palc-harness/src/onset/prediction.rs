@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use palc_aggregator::Onset;
 
 use crate::setup::{Setup, target_gaps_safe};
-use crate::user::Situation;
+use palc_user::Situation;
 
 /// Relative spread below which a decision feature counts as consistent across
 /// scenes.

@@ -3,8 +3,8 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::HarnessError;
-use crate::user::situation::Situation;
+use crate::UserError;
+use crate::situation::Situation;
 
 /// A driving style: what one user expects of a lane change.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -57,7 +57,7 @@ impl Style {
     }
 
     /// Checks every field is finite and positive, naming the first that is not.
-    pub fn validate(&self, field: &str) -> Result<(), HarnessError> {
+    pub fn validate(&self, field: &str) -> Result<(), UserError> {
         let fields = [
             ("time_headway_s", self.time_headway_s),
             ("lane_change_duration_s", self.lane_change_duration_s),
@@ -65,7 +65,7 @@ impl Style {
         ];
         for (name, value) in fields {
             if !(value.is_finite() && value > 0.0) {
-                return Err(HarnessError::InvalidConfig {
+                return Err(UserError::InvalidConfig {
                     field: format!("{field}.{name}"),
                     value,
                     bound: "a finite value > 0".to_owned(),
@@ -75,7 +75,7 @@ impl Style {
         if !(self.min_lag_gap_s.is_finite()
             && (0.0..=MAX_GAP_ACCEPTANCE_S).contains(&self.min_lag_gap_s))
         {
-            return Err(HarnessError::InvalidConfig {
+            return Err(UserError::InvalidConfig {
                 field: format!("{field}.min_lag_gap_s"),
                 value: self.min_lag_gap_s,
                 bound: format!("a value in [0, {MAX_GAP_ACCEPTANCE_S:?}]"),
@@ -160,7 +160,7 @@ impl StylePreset {
     }
 
     /// The valid names, quoted, for messages: `` `aggressive`, `neutral`, `cautious` ``.
-    pub(crate) fn quoted_names() -> String {
+    pub fn quoted_names() -> String {
         Self::ALL
             .map(|preset| format!("`{}`", preset.name()))
             .join(", ")
@@ -174,14 +174,14 @@ impl std::fmt::Display for StylePreset {
 }
 
 impl std::str::FromStr for StylePreset {
-    type Err = HarnessError;
+    type Err = UserError;
 
-    /// The preset with this name; [`HarnessError::UnknownStyle`] lists the valid names.
+    /// The preset with this name; [`UserError::UnknownStyle`] lists the valid names.
     fn from_str(name: &str) -> Result<Self, Self::Err> {
         Self::ALL
             .into_iter()
             .find(|preset| preset.name() == name)
-            .ok_or_else(|| HarnessError::UnknownStyle {
+            .ok_or_else(|| UserError::UnknownStyle {
                 name: name.to_owned(),
                 expected: Self::quoted_names(),
             })

@@ -4,18 +4,18 @@
 use palc_planner::State;
 use rand_chacha::ChaCha8Rng;
 
-use crate::HarnessError;
-use crate::setup::{Setup, target_gaps_safe};
-use crate::user::User;
-use crate::user::expectation::{
+use crate::User;
+use crate::error::{UserError, UserRefusal};
+use crate::expectation::{
     Expectation, ExpectedLaneChange, MAX_LATERAL_ACCELERATION_MPS2, MAX_LATERAL_JERK_MPS3,
     TakeoverRule,
 };
-use crate::user::family::{Family, SpeedRule};
-use crate::user::profile::TABLE_END_TOLERANCE_M;
-use crate::user::situation::Situation;
-use crate::user::spread::Spread;
-use crate::user::style::Style;
+use crate::family::{Family, SpeedRule};
+use crate::profile::TABLE_END_TOLERANCE_M;
+use crate::scene::UserScene;
+use crate::situation::Situation;
+use crate::spread::Spread;
+use crate::style::Style;
 
 /// Most draws of one lane change's parameters (a draw whose lane change fails the
 /// sanity checks is drawn again).
@@ -38,18 +38,18 @@ impl SimulatedUser {
     /// beyond `deviation_m` of lateral deviation, with `spread` if given.
     ///
     /// # Errors
-    /// [`HarnessError::InvalidConfig`] naming the field of a parameter out of its bound.
+    /// [`UserError::InvalidConfig`] naming the field of a parameter out of its bound.
     pub fn new(
         name: impl Into<String>,
         style: Style,
         family: Family,
         deviation_m: f64,
         spread: Option<Spread>,
-    ) -> Result<Self, HarnessError> {
+    ) -> Result<Self, UserError> {
         style.validate("user.style")?;
         family.validate("user.family")?;
         if !(deviation_m.is_finite() && deviation_m > 0.0) {
-            return Err(HarnessError::InvalidConfig {
+            return Err(UserError::InvalidConfig {
                 field: "planning.takeover_threshold_m".to_owned(),
                 value: deviation_m,
                 bound: "a finite value > 0".to_owned(),
@@ -69,7 +69,7 @@ impl SimulatedUser {
     }
 
     /// The paper's user of `style`: no family rules, no spread, the paper's 0.3 m.
-    pub fn paper(style: Style) -> Result<Self, HarnessError> {
+    pub fn paper(style: Style) -> Result<Self, UserError> {
         Self::new("paper", style, Family::default(), 0.3, None)
     }
 
@@ -83,38 +83,35 @@ impl SimulatedUser {
         &self.family
     }
 
-    /// The lane change a user of `style` and `family` expects in `setup`, checked
+    /// The lane change a user of `style` and `family` expects in `scene`, checked
     /// for sanity; the error says what failed.
     fn expectation(
         &self,
         style: &Style,
         family: &Family,
-        setup: &Setup,
-    ) -> Result<Expectation, HarnessError> {
-        let refuse = |reason: String| HarnessError::Scenario {
-            scenario: setup.label.clone(),
-            reason: format!("user `{}`: {reason}", self.name),
+        scene: &UserScene<'_>,
+    ) -> Result<Expectation, UserError> {
+        let refuse = |refusal: UserRefusal| UserError::Refused {
+            user: self.name.clone(),
+            refusal,
         };
-        let situations = &setup.situations;
-        let dt = setup.dt;
-        let window = situations.len().saturating_sub(1);
+        let situations = scene.situations;
+        let dt = scene.dt;
+        let window = scene.window();
         let decision_step = situations
             .iter()
             .position(|s| family.start.decides(s, style.time_headway_s))
             .ok_or_else(|| {
-                refuse(format!(
-                    "its {} start rule is never met within the {:.1} s search window",
-                    family.start.name(),
-                    window as f64 * dt
-                ))
+                refuse(UserRefusal::StartRuleNeverMet {
+                    rule: family.start.name().to_owned(),
+                    window_s: window as f64 * dt,
+                })
             })?;
         if decision_step == 0 {
-            return Err(refuse(format!(
-                "its {} start rule is already met when planning starts (time headway {:.2} s): \
-                 the user would have changed lanes before the system plans",
-                family.start.name(),
-                situations[0].time_headway_s
-            )));
+            return Err(refuse(UserRefusal::StartRuleMetAtTrigger {
+                rule: family.start.name().to_owned(),
+                time_headway_s: situations[0].time_headway_s,
+            }));
         }
         let accepting = Style {
             min_lead_gap_s: family.min_lead_gap_s.unwrap_or(style.min_lead_gap_s),
@@ -136,7 +133,6 @@ impl SimulatedUser {
         // 19.9 m RSS distance, at step 69 (collector-high / 35 m / seed 1, cautious),
         // and the safety layer refused the plans that copied it
         // (docs/paper-mapping.md, "Users who wait for safe gaps").
-        let safety = &setup.safety;
         // A user with a speed of its own (speed matching) checks the gaps on its
         // own motion from the start on as well: checked on the lane keeping's alone,
         // a speed-matching user slowing towards the target lane's speed fell 7.1 m
@@ -147,13 +143,13 @@ impl SimulatedUser {
         // check below refuses it), and its step count must not overflow here.
         let duration_steps = (duration_s / dt).ceil() as usize;
         let safe = |i: usize| {
-            if !safety.users_wait_for_safe_gaps {
+            let Some(safe_gaps) = scene.safe_gaps else {
                 return true;
-            }
-            let target_speed = target_speed_at(&situations[i], setup.set_speed);
-            let mut own = setup.lane_keeping[i];
+            };
+            let target_speed = target_speed_at(&situations[i], scene.set_speed);
+            let mut own = scene.lane_keeping[i];
             (i..=i.saturating_add(duration_steps).min(window)).all(|j| {
-                let keeping = setup.lane_keeping[j];
+                let keeping = scene.lane_keeping[j];
                 if j > i {
                     own = match speed_rule_step(family.speed, own[1], target_speed, dt) {
                         Some(v) => [own[0] + 0.5 * (own[1] + v) * dt, v],
@@ -161,33 +157,28 @@ impl SimulatedUser {
                     };
                 }
                 let seen = situations[j].seen_from(own[0] - keeping[0], own[1]);
-                target_gaps_safe(&situations[j], safety) && target_gaps_safe(&seen, safety)
+                safe_gaps.target_gaps_safe(&situations[j]) && safe_gaps.target_gaps_safe(&seen)
             })
         };
         let start_step = (earliest..=window)
             .find(|&i| accepting.accepts(&situations[i]) && safe(i))
             .ok_or_else(|| {
-                refuse(format!(
-                    "the target lane's gaps never become acceptable to it (lead {:.2} s, lag \
-                     {:.2} s{}) within the search window after its decision at step {decision_step}",
-                    accepting.min_lead_gap_s,
-                    accepting.min_lag_gap_s,
-                    if safety.users_wait_for_safe_gaps {
-                        ", and the RSS safe distance at every step of the lane change"
-                    } else {
-                        ""
-                    }
-                ))
+                refuse(UserRefusal::GapsNeverAcceptable {
+                    min_lead_gap_s: accepting.min_lead_gap_s,
+                    min_lag_gap_s: accepting.min_lag_gap_s,
+                    safe_distance: scene.safe_gaps.is_some(),
+                    decision_step,
+                })
             })?;
         let lane_change = ExpectedLaneChange {
             start_s: start_step as f64 * dt,
             duration_s,
             from_l: 0.0,
-            to_l: setup.target_l,
+            to_l: scene.target_l,
             profile: family.profile.clone(),
         };
-        let target_speed = target_speed_at(&situations[start_step], setup.set_speed);
-        let states = expected_states(setup, &lane_change, start_step, family.speed, target_speed);
+        let target_speed = target_speed_at(&situations[start_step], scene.set_speed);
+        let states = expected_states(scene, &lane_change, start_step, family.speed, target_speed);
         let expectation = Expectation {
             lane_change,
             decision_step,
@@ -200,7 +191,7 @@ impl SimulatedUser {
             speed: family.speed,
             target_speed,
         };
-        sanity(&expectation, setup).map_err(refuse)?;
+        sanity(&expectation, scene).map_err(refuse)?;
         Ok(expectation)
     }
 }
@@ -208,17 +199,17 @@ impl SimulatedUser {
 /// The states of the expected lane change: the ego keeping its lane until the
 /// start, then moving laterally along the profile at the speed of `speed`.
 fn expected_states(
-    setup: &Setup,
+    scene: &UserScene<'_>,
     lane_change: &ExpectedLaneChange,
     start_step: usize,
     speed: SpeedRule,
     target_speed: f64,
 ) -> Vec<State> {
-    let dt = setup.dt;
-    let n = setup.situations.len();
+    let dt = scene.dt;
+    let n = scene.situations.len();
     let mut states: Vec<State> = Vec::with_capacity(n);
     for i in 0..n {
-        let [keeping_s, keeping_v] = setup.lane_keeping[i.min(setup.lane_keeping.len() - 1)];
+        let [keeping_s, keeping_v] = scene.lane_keeping[i.min(scene.lane_keeping.len() - 1)];
         let own = states
             .last()
             .filter(|_| i > start_step)
@@ -268,14 +259,14 @@ fn speed_rule_step(speed: SpeedRule, v: f64, target_speed: f64, dt: f64) -> Opti
 /// The sanity checks of an expected lane change: it ends inside the search
 /// window, goes from the current lane's centre to the target lane's, stays
 /// between the two lanes, and is smooth (bounded lateral acceleration and jerk).
-fn sanity(expectation: &Expectation, setup: &Setup) -> Result<(), String> {
+fn sanity(expectation: &Expectation, scene: &UserScene<'_>) -> Result<(), UserRefusal> {
     let lane_change = &expectation.lane_change;
-    let window_s = (setup.situations.len().saturating_sub(1)) as f64 * setup.dt;
+    let window_s = scene.window_s();
     if lane_change.end_s() > window_s + 1e-9 {
-        return Err(format!(
-            "its lane change ends at {:.2} s, after the {window_s:.1} s search window",
-            lane_change.end_s()
-        ));
+        return Err(UserRefusal::EndsAfterWindow {
+            end_s: lane_change.end_s(),
+            window_s,
+        });
     }
     let width = (lane_change.to_l - lane_change.from_l).abs();
     let start = lane_change.lateral(lane_change.start_s);
@@ -283,11 +274,12 @@ fn sanity(expectation: &Expectation, setup: &Setup) -> Result<(), String> {
     if (start - lane_change.from_l).abs() > TABLE_END_TOLERANCE_M
         || (end - lane_change.to_l).abs() > TABLE_END_TOLERANCE_M
     {
-        return Err(format!(
-            "its lane change goes from l = {start:.3} m to l = {end:.3} m, not from the lane \
-             centre at {:.3} m to the target lane's at {:.3} m",
-            lane_change.from_l, lane_change.to_l
-        ));
+        return Err(UserRefusal::NotCentreToCentre {
+            start_l: start,
+            end_l: end,
+            from_l: lane_change.from_l,
+            to_l: lane_change.to_l,
+        });
     }
     let (low, high) = (
         lane_change.from_l.min(lane_change.to_l) - 0.5 * width,
@@ -298,20 +290,22 @@ fn sanity(expectation: &Expectation, setup: &Setup) -> Result<(), String> {
         .iter()
         .find(|x| !(low..=high).contains(&x.l))
     {
-        return Err(format!(
-            "its lane change leaves the two lanes (l = {:.3} m, outside [{low:.3}, {high:.3}] m)",
-            state.l
-        ));
+        return Err(UserRefusal::LeavesLanes {
+            l: state.l,
+            low,
+            high,
+        });
     }
     let (acceleration, jerk) = lane_change.peak_acceleration_and_jerk();
     if acceleration > MAX_LATERAL_ACCELERATION_MPS2 || jerk > MAX_LATERAL_JERK_MPS3 {
-        return Err(format!(
-            "its {} profile over {:.2} s is not smooth enough: lateral acceleration {acceleration:.1} \
-             m/s² (at most {MAX_LATERAL_ACCELERATION_MPS2}), jerk {jerk:.0} m/s³ (at most \
-             {MAX_LATERAL_JERK_MPS3})",
-            lane_change.profile.name(),
-            lane_change.duration_s
-        ));
+        return Err(UserRefusal::NotSmooth {
+            profile: lane_change.profile.name().to_owned(),
+            duration_s: lane_change.duration_s,
+            acceleration_mps2: acceleration,
+            max_acceleration_mps2: MAX_LATERAL_ACCELERATION_MPS2,
+            jerk_mps3: jerk,
+            max_jerk_mps3: MAX_LATERAL_JERK_MPS3,
+        });
     }
     Ok(())
 }
@@ -321,29 +315,29 @@ impl User for SimulatedUser {
         &self.name
     }
 
-    fn nominal(&self, setup: &Setup) -> Result<Expectation, HarnessError> {
-        self.expectation(&self.style, &self.family, setup)
+    fn nominal(&self, scene: &UserScene<'_>) -> Result<Expectation, UserError> {
+        self.expectation(&self.style, &self.family, scene)
     }
 
     /// The next lane change; a user with spread draws its parameters anew, and
     /// draws again (up to [`MAX_DRAWS`] times) while the drawn lane change fails
     /// its sanity checks, so that one unlucky draw does not end a run.
-    fn next(&mut self, setup: &Setup) -> Result<Expectation, HarnessError> {
+    fn next(&mut self, scene: &UserScene<'_>) -> Result<Expectation, UserError> {
         let Some(spread) = self.spread.filter(Spread::is_active) else {
-            return self.nominal(setup);
+            return self.nominal(scene);
         };
         let mut last = None;
         for _ in 0..MAX_DRAWS {
             let Some(rng) = self.rng.as_mut() else { break };
             let (style, family) = spread.draw(&self.style, &self.family, rng);
-            match self.expectation(&style, &family, setup) {
+            match self.expectation(&style, &family, scene) {
                 Ok(expectation) => return Ok(expectation),
                 Err(error) => last = Some(error),
             }
         }
-        Err(last.unwrap_or_else(|| HarnessError::Scenario {
-            scenario: setup.label.clone(),
-            reason: format!("user `{}` has no generator for its spread", self.name),
+        Err(last.unwrap_or_else(|| UserError::Refused {
+            user: self.name.clone(),
+            refusal: UserRefusal::NoSpreadGenerator,
         }))
     }
 

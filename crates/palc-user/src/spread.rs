@@ -6,13 +6,13 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
-use crate::HarnessError;
-use crate::user::family::{
+use crate::UserError;
+use crate::family::{
     ACCELERATION_BOUNDS_MPS2, COMFORT_TIME_GAP_BOUNDS_S, COMFORT_TTC_BOUNDS_S,
     DISTANCE_START_BOUNDS_M, Family, MAX_REACTION_S, SpeedRule, StartRule, TTC_START_BOUNDS_S,
 };
-use crate::user::profile::{LateralProfile, PEAK_FRACTION_BOUNDS};
-use crate::user::style::{MAX_GAP_ACCEPTANCE_S, Style};
+use crate::profile::{LateralProfile, PEAK_FRACTION_BOUNDS};
+use crate::style::{MAX_GAP_ACCEPTANCE_S, Style};
 
 /// Largest relative half-width: a draw never halves or doubles a parameter.
 pub const MAX_RELATIVE_SPREAD: f64 = 0.5;
@@ -30,7 +30,7 @@ pub enum Draw {
 }
 
 impl Draw {
-    fn validate(&self, field: &str) -> Result<(), HarnessError> {
+    fn validate(&self, field: &str) -> Result<(), UserError> {
         let (value, bound, ok) = match *self {
             Draw::Relative(w) => (
                 w,
@@ -46,7 +46,7 @@ impl Draw {
         if value.is_finite() && ok {
             Ok(())
         } else {
-            Err(HarnessError::InvalidConfig {
+            Err(UserError::InvalidConfig {
                 field: field.to_owned(),
                 value,
                 bound,
@@ -117,7 +117,7 @@ impl ParameterSpread {
 
     /// Checks every half-width, naming the field under `table`
     /// (`{table}.reaction_s.absolute`).
-    pub fn validate(&self, table: &str) -> Result<(), HarnessError> {
+    pub fn validate(&self, table: &str) -> Result<(), UserError> {
         for (name, draw) in self.named() {
             if let Some(draw) = draw {
                 let kind = match draw {
@@ -148,7 +148,7 @@ pub struct Spread {
 
 impl Spread {
     /// Checks every half-width, naming the field under `table`.
-    pub fn validate(&self, table: &str) -> Result<(), HarnessError> {
+    pub fn validate(&self, table: &str) -> Result<(), UserError> {
         Draw::Relative(self.relative).validate(&format!("{table}.relative"))?;
         self.parameters.validate(&format!("{table}.parameters"))
     }
@@ -241,7 +241,7 @@ impl Spread {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::user::family::PerceivedSafety;
+    use crate::family::PerceivedSafety;
 
     #[test]
     fn relative_spread_draws_as_the_paper_user_always_has() {

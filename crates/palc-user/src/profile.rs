@@ -22,7 +22,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::HarnessError;
+use crate::UserError;
 
 /// Smallest and largest `peak_fraction` of the asymmetric profile.
 /// At the bounds the peak lateral acceleration is 1.67 times the quintic's.
@@ -77,8 +77,8 @@ impl LateralProfile {
     }
 
     /// Checks the shape's parameters, naming the field under `table` that is out of bound.
-    pub fn validate(&self, table: &str) -> Result<(), HarnessError> {
-        let invalid = |field: String, value: f64, bound: &str| HarnessError::InvalidConfig {
+    pub fn validate(&self, table: &str) -> Result<(), UserError> {
+        let invalid = |field: String, value: f64, bound: &str| UserError::InvalidConfig {
             field,
             value,
             bound: bound.to_owned(),

@@ -2,17 +2,18 @@
 //! long it reacts, the shape of its lateral move, its speed during the lane
 //! change, and when it takes over for safety rather than for the path.
 //!
-//! A [`Family`] refines a [`Style`](crate::user::Style) (the paper's headway,
+//! A [`Family`] refines a [`Style`](crate::Style) (the paper's headway,
 //! duration and gap acceptance): its defaults are the paper's user, so an empty
 //! `[user.family]` table changes nothing. docs/paper-mapping.md ("User
 //! families") says why each rule is plausible for a human driver.
 
 use serde::{Deserialize, Serialize};
 
-use crate::HarnessError;
-use crate::user::profile::LateralProfile;
-use crate::user::situation::Situation;
-use crate::user::style::MAX_GAP_ACCEPTANCE_S;
+use crate::UserError;
+use crate::error::within;
+use crate::profile::LateralProfile;
+use crate::situation::Situation;
+use crate::style::MAX_GAP_ACCEPTANCE_S;
 
 /// Bounds of the time-to-collision start threshold (s).
 pub const TTC_START_BOUNDS_S: (f64, f64) = (1.0, 30.0);
@@ -76,7 +77,7 @@ impl StartRule {
             }
     }
 
-    fn validate(&self, table: &str) -> Result<(), HarnessError> {
+    fn validate(&self, table: &str) -> Result<(), UserError> {
         match *self {
             StartRule::TimeHeadway => Ok(()),
             StartRule::TimeToCollision { seconds } => {
@@ -172,7 +173,7 @@ impl PerceivedSafety {
             .map(|(lead, (gap, ttc))| (lead, gap, ttc))
     }
 
-    fn validate(&self, table: &str) -> Result<(), HarnessError> {
+    fn validate(&self, table: &str) -> Result<(), UserError> {
         within(
             &format!("{table}.min_time_gap_s"),
             self.min_time_gap_s,
@@ -223,7 +224,7 @@ impl Family {
     }
 
     /// Checks every parameter against its bound, naming the field under `table`.
-    pub fn validate(&self, table: &str) -> Result<(), HarnessError> {
+    pub fn validate(&self, table: &str) -> Result<(), UserError> {
         self.start.validate(&format!("{table}.start"))?;
         within(
             &format!("{table}.reaction_s"),
@@ -257,19 +258,6 @@ impl Family {
             comfort.validate(&format!("{table}.perceived_safety"))?;
         }
         Ok(())
-    }
-}
-
-/// `Ok` when `value` is finite and in `[low, high]`, else the error naming `field`.
-pub(crate) fn within(field: &str, value: f64, (low, high): (f64, f64)) -> Result<(), HarnessError> {
-    if value.is_finite() && (low..=high).contains(&value) {
-        Ok(())
-    } else {
-        Err(HarnessError::InvalidConfig {
-            field: field.to_owned(),
-            value,
-            bound: format!("a value in [{low:?}, {high:?}]"),
-        })
     }
 }
 

@@ -1,11 +1,16 @@
-//! Simulated users: what a user expects of a lane change, when it takes over,
-//! and how it drives after a takeover.
+//! Drivers of personalized automated lane change (PALC): what a driver
+//! expects of a lane change, when it takes over, and how it drives after a
+//! takeover.
 //!
 //! A user is anything that implements [`User`]: the built-in [`SimulatedUser`]
 //! or an embedder's own (a recorded driver, a person at a driving simulator,
-//! another simulator's driver model). The loop asks a user for the lane change it
-//! expects in a scenario ([`User::next`]), lets it judge the plan step by step as
-//! it is driven ([`User::takes_over`]), and lets it drive after a takeover
+//! another simulator's driver model). It sees a scenario only through a
+//! [`UserScene`] (plain numbers: the step, what it sees at each step with the
+//! ego keeping its lane, the ego's motion, the target lane's centre), so a
+//! driver model compiles and is tested without the loop that runs it
+//! (`palc-harness`). The loop asks a user for the lane change it expects in a
+//! scenario ([`User::next`]), lets it judge the plan step by step as it is
+//! driven ([`User::takes_over`]), and lets it drive after a takeover
 //! ([`User::acceleration_after_takeover`], along its expected lateral path).
 //!
 //! The built-in user is the paper's (Section III.A: three styles, each a time
@@ -23,11 +28,17 @@
 //!
 //! Every expectation of the built-in user is checked for sanity (inside the search
 //! window, from lane centre to lane centre, between the two lanes, bounded lateral
-//! acceleration and jerk), or the scenario is refused naming the user and what failed.
+//! acceleration and jerk), or the user refuses the scenario with a typed
+//! [`UserRefusal`] naming what failed.
+#![deny(missing_docs)]
+#![warn(clippy::print_stdout, clippy::print_stderr)]
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
+mod error;
 mod expectation;
 mod family;
 mod profile;
+mod scene;
 mod simulated;
 mod situation;
 mod spread;
@@ -35,6 +46,7 @@ mod style;
 
 use palc_planner::State;
 
+pub use error::{UserError, UserRefusal, within};
 pub use expectation::{
     Expectation, ExpectedLaneChange, MAX_LATERAL_ACCELERATION_MPS2, MAX_LATERAL_JERK_MPS3,
     SMOOTHNESS_STEP_S, TakeoverCause, TakeoverRule,
@@ -48,25 +60,23 @@ pub use profile::{
     LateralProfile, MAX_TABLE_POINTS, PEAK_FRACTION_BOUNDS, ProfilePoint, TABLE_END_TOLERANCE_M,
     quintic,
 };
+pub use scene::{SafeDistance, UserScene};
 pub use simulated::{MAX_DRAWS, SimulatedUser};
 pub use situation::Situation;
 pub use spread::{Draw, MAX_ABSOLUTE_SPREAD, MAX_RELATIVE_SPREAD, ParameterSpread, Spread};
 pub use style::{MAX_GAP_ACCEPTANCE_S, Style, StylePreset};
 
-use crate::HarnessError;
-use crate::setup::Setup;
-
 /// A user of the lesson-learning loop: what it expects, when it takes over, how
 /// it drives after a takeover.
 ///
-/// Implement it to bring a user of your own into [`crate::LearningLoop::with_user`];
-/// the provided methods apply the expectation's own [`TakeoverRule`] and speed
-/// rule, so a user that only computes expectations needs only the three required
-/// methods.
+/// Implement it to bring a user of your own into the loop (in `palc-harness`,
+/// `LearningLoop::with_user`); the provided methods apply the expectation's own
+/// [`TakeoverRule`] and speed rule, so a user that only computes expectations
+/// needs only the three required methods. `Send`, so that loops run on threads
+/// and users come from other languages.
 ///
 /// ```
-/// use palc_harness::user::{Expectation, SimulatedUser, Style, User};
-/// use palc_harness::{HarnessError, Setup};
+/// use palc_user::{Expectation, SimulatedUser, Style, User, UserError, UserScene};
 ///
 /// /// A user who expects the neutral style's lane change half a second later.
 /// #[derive(Debug)]
@@ -76,38 +86,38 @@ use crate::setup::Setup;
 ///     fn name(&self) -> &str {
 ///         "late"
 ///     }
-///     fn nominal(&self, setup: &Setup) -> Result<Expectation, HarnessError> {
-///         let mut expectation = self.0.nominal(setup)?;
+///     fn nominal(&self, scene: &UserScene<'_>) -> Result<Expectation, UserError> {
+///         let mut expectation = self.0.nominal(scene)?;
 ///         expectation.lane_change.start_s += 0.5;
 ///         for (i, state) in expectation.states.iter_mut().enumerate() {
-///             state.l = expectation.lane_change.lateral(i as f64 * setup.dt);
+///             state.l = expectation.lane_change.lateral(i as f64 * scene.dt);
 ///         }
 ///         Ok(expectation)
 ///     }
-///     fn next(&mut self, setup: &Setup) -> Result<Expectation, HarnessError> {
-///         self.nominal(setup)
+///     fn next(&mut self, scene: &UserScene<'_>) -> Result<Expectation, UserError> {
+///         self.nominal(scene)
 ///     }
 /// }
 /// # let _ = Late(SimulatedUser::paper(Style::NEUTRAL)?);
-/// # Ok::<(), HarnessError>(())
+/// # Ok::<(), UserError>(())
 /// ```
-pub trait User: std::fmt::Debug {
+pub trait User: std::fmt::Debug + Send {
     /// The user's name in messages.
     fn name(&self) -> &str;
 
-    /// The lane change the user expects in `setup` with its nominal parameters:
+    /// The lane change the user expects in `scene` with its nominal parameters:
     /// the ceiling of a user with spread is this trajectory's takeover rate.
     ///
     /// # Errors
-    /// [`HarnessError::Scenario`] when the user has no sane lane change in the scenario.
-    fn nominal(&self, setup: &Setup) -> Result<Expectation, HarnessError>;
+    /// [`UserError::Refused`] when the user has no sane lane change in the scenario.
+    fn nominal(&self, scene: &UserScene<'_>) -> Result<Expectation, UserError>;
 
     /// The lane change the user expects in the next lane change (a user with
     /// spread draws its parameters anew).
     ///
     /// # Errors
     /// As [`User::nominal`].
-    fn next(&mut self, setup: &Setup) -> Result<Expectation, HarnessError>;
+    fn next(&mut self, scene: &UserScene<'_>) -> Result<Expectation, UserError>;
 
     /// Whether the user's parameters vary between lane changes.
     fn has_spread(&self) -> bool {

@@ -5,9 +5,9 @@
 use palc_planner::State;
 use serde::{Deserialize, Serialize};
 
-use crate::user::family::{PerceivedSafety, SpeedRule};
-use crate::user::profile::LateralProfile;
-use crate::user::situation::Situation;
+use crate::family::{PerceivedSafety, SpeedRule};
+use crate::profile::LateralProfile;
+use crate::situation::Situation;
 
 /// Largest lateral acceleration of an expected lane change (m/s²): about 1 g,
 /// beyond any driver's lane change (the paper's aggressive quintic peaks at

@@ -27,7 +27,7 @@ impl Situation {
     /// The same scene seen from an ego `ahead_m` further along its lane (negative:
     /// behind) at `ego_speed`: the target lane's gaps shifted by that distance (the
     /// lead's shorter, the lag's longer), the vehicles where they were.
-    pub(crate) fn seen_from(&self, ahead_m: f64, ego_speed: f64) -> Situation {
+    pub fn seen_from(&self, ahead_m: f64, ego_speed: f64) -> Situation {
         Situation {
             target_lead_gap_m: self.target_lead_gap_m.map(|gap| gap - ahead_m),
             target_lag_gap_m: self.target_lag_gap_m.map(|gap| gap + ahead_m),
