@@ -54,6 +54,7 @@ mod builder;
 mod clarabel_backend;
 mod config;
 mod convexity;
+mod dynamics;
 mod error;
 mod features;
 mod planner;

@@ -28,7 +28,7 @@
 
 use nalgebra::{Matrix4, Matrix6, Vector4, Vector6};
 
-use crate::riccati::StepDynamics;
+use crate::dynamics::{Dynamics, StepDynamics};
 use crate::{LateralBoundsMode, PlannerConfig, Problem, feature};
 
 /// States per step (`[s, v, l, φ]`, Eq. 9).
@@ -75,14 +75,6 @@ pub(crate) enum RowTag {
     Steering(usize),
     Lateral(usize),
     Slack,
-}
-
-/// `X_{i+1} = A X_i + B U_i + c` (Eqs. 11-14); `sparse` holds `A` and `B` in the
-/// cheapest exact form for the products of the recursion.
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct Dynamics {
-    pub c: Vector4<f64>,
-    pub sparse: StepDynamics,
 }
 
 /// The index of an absent variable in an [`Inequality`].

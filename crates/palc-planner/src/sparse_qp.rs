@@ -10,8 +10,8 @@
 //! of each dynamics step (Eqs. 11-14), so that the pattern depends only on `K`, the
 //! bound pattern, the mode and whether `s_K` is fixed.
 
+use crate::dynamics::StepDynamics;
 use crate::qp::{NX, StageQp, control_index, state_index};
-use crate::riccati::StepDynamics;
 
 /// The triplets and vectors of one plan's QP; rebuilt for each plan (cheap), then
 /// scattered into a cached CSC pattern.

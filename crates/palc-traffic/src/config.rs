@@ -7,6 +7,7 @@
 use crate::error::ConfigError;
 use crate::idm::{DesiredGap, IdmParams};
 use crate::road::Road;
+use crate::validate::{in_range, non_negative, out_of_range, positive};
 use serde::{Deserialize, Serialize};
 
 /// Parses TOML text; an error names the dotted path of the field it is in (e.g.
@@ -49,9 +50,6 @@ fn field_path(path: &serde_path_to_error::Path) -> String {
         path.to_string()
     }
 }
-
-/// Largest plausible road speed in a config (mph); bigger values are most likely km/h.
-pub const MAX_SPEED_MPH: f64 = 100.0;
 
 /// A whole scenario config: road, vehicles, IDM and exactly one of `testbed` or `platoon`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -200,7 +198,7 @@ pub struct TestbedConfig {
     /// A stress scene: the target lane's lag vehicle accelerates into the gap when
     /// the ego starts its lane change. None (the paper's test bed) if absent.
     #[serde(default)]
-    pub lag_accelerating: Option<crate::lag::LagAcceleratingConfig>,
+    pub lag_accelerating: Option<LagAcceleratingConfig>,
 }
 
 /// `[testbed.preceding_braking]`: the preceding vehicle holds the background speed,
@@ -214,6 +212,56 @@ pub struct PrecedingBrakingConfig {
     pub deceleration_mps2: f64,
     /// Speed after braking, as a fraction of the background speed, in [0, 1).
     pub final_speed_ratio: f64,
+}
+
+/// Largest `testbed.lag_accelerating.acceleration_mps2` (m/s^2): a hard
+/// acceleration of a passenger car.
+pub const MAX_LAG_ACCELERATION_MPS2: f64 = 6.0;
+
+/// `[testbed.lag_accelerating]`: the target lane's lag vehicle accelerates into the
+/// gap when the ego starts its lane change.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LagAcceleratingConfig {
+    /// The ego's lateral offset from the centre of its start lane, towards the
+    /// target lane, at which the lag vehicle starts accelerating (m), in (0, lane width].
+    pub trigger_lateral_m: f64,
+    /// The lag vehicle's maximum acceleration after the trigger (m/s^2), in
+    /// \[0.1, [`MAX_LAG_ACCELERATION_MPS2`]\].
+    pub acceleration_mps2: f64,
+    /// The lag vehicle's desired speed after the trigger, as a multiple of its speed
+    /// at the trigger, in (1, 2].
+    pub speed_ratio: f64,
+}
+
+impl LagAcceleratingConfig {
+    /// Checks every field against its bound; `lane_width` is the road's (m).
+    ///
+    /// # Errors
+    /// [`ConfigError::OutOfRange`] naming `testbed.lag_accelerating.<field>`.
+    pub fn validate(&self, lane_width: f64) -> Result<(), ConfigError> {
+        let field = |name: &str| format!("testbed.lag_accelerating.{name}");
+        let trigger = self.trigger_lateral_m;
+        if !(trigger > 0.0 && trigger <= lane_width) {
+            return Err(out_of_range(
+                &field("trigger_lateral_m"),
+                trigger,
+                &format!("in (0, {lane_width:?}] m, within one lane width"),
+            ));
+        }
+        in_range(
+            &field("acceleration_mps2"),
+            self.acceleration_mps2,
+            0.1,
+            MAX_LAG_ACCELERATION_MPS2,
+            &format!("in [0.1, {MAX_LAG_ACCELERATION_MPS2:?}] m/s^2"),
+        )?;
+        let ratio = self.speed_ratio;
+        if !(ratio > 1.0 && ratio <= 2.0) {
+            return Err(out_of_range(&field("speed_ratio"), ratio, "in (1, 2]"));
+        }
+        Ok(())
+    }
 }
 
 fn default_ego_start() -> f64 {
@@ -346,64 +394,5 @@ impl ScenarioConfig {
             lane_width: r.lane_width_m,
             lanes: r.lanes,
         })
-    }
-}
-
-pub(crate) fn out_of_range(field: &str, value: f64, bound: &str) -> ConfigError {
-    ConfigError::OutOfRange {
-        field: field.to_owned(),
-        value,
-        bound: bound.to_owned(),
-    }
-}
-
-/// Finite and strictly positive.
-pub(crate) fn positive(field: &str, value: f64) -> Result<f64, ConfigError> {
-    in_range(
-        field,
-        value,
-        f64::MIN_POSITIVE,
-        f64::MAX,
-        "finite and above 0",
-    )
-}
-
-/// Finite and not negative.
-pub(crate) fn non_negative(field: &str, value: f64) -> Result<f64, ConfigError> {
-    in_range(field, value, 0.0, f64::MAX, "finite and at least 0")
-}
-
-/// Within `[min, max]` and not NaN; `bound` describes the range for the message.
-pub(crate) fn in_range(
-    field: &str,
-    value: f64,
-    min: f64,
-    max: f64,
-    bound: &str,
-) -> Result<f64, ConfigError> {
-    if value >= min && value <= max {
-        Ok(value)
-    } else {
-        Err(out_of_range(field, value, bound))
-    }
-}
-
-/// A speed in mph within `(0, MAX_SPEED_MPH]`, or within `[0, ..]` when `allow_zero`.
-pub(crate) fn speed_mph(field: &str, value: f64, allow_zero: bool) -> Result<f64, ConfigError> {
-    let ok = value <= MAX_SPEED_MPH
-        && if allow_zero {
-            value >= 0.0
-        } else {
-            value > 0.0
-        };
-    if ok {
-        Ok(value)
-    } else {
-        let lower = if allow_zero { "[0" } else { "(0" };
-        Err(out_of_range(
-            field,
-            value,
-            &format!("in {lower}, {MAX_SPEED_MPH}] mph (a larger value may be in km/h)"),
-        ))
     }
 }

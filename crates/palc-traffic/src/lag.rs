@@ -10,78 +10,16 @@
 //! occupies its lane ahead, the ego included once the ego's body enters it, so it
 //! closes the gap without ramming: the ego finds a shrinking gap, below the safe
 //! distance if it goes on.
+//!
+//! The table is [`LagAcceleratingConfig`], kept with the other tables in `config.rs`,
+//! and the armed state a field of the [`Scene`] (`LagPush`); this module holds the
+//! behaviour.
 
-use serde::{Deserialize, Serialize};
-
-use crate::config::in_range;
+use crate::config::LagAcceleratingConfig;
 use crate::error::ConfigError;
 use crate::road::Lane;
-use crate::scene::Scene;
+use crate::scene::{LagPush, Scene};
 use crate::vehicle::Driver;
-
-/// Largest `testbed.lag_accelerating.acceleration_mps2` (m/s^2): a hard
-/// acceleration of a passenger car.
-pub const MAX_LAG_ACCELERATION_MPS2: f64 = 6.0;
-
-/// `[testbed.lag_accelerating]`: the target lane's lag vehicle accelerates into the
-/// gap when the ego starts its lane change.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct LagAcceleratingConfig {
-    /// The ego's lateral offset from the centre of its start lane, towards the
-    /// target lane, at which the lag vehicle starts accelerating (m), in (0, lane width].
-    pub trigger_lateral_m: f64,
-    /// The lag vehicle's maximum acceleration after the trigger (m/s^2), in
-    /// \[0.1, [`MAX_LAG_ACCELERATION_MPS2`]\].
-    pub acceleration_mps2: f64,
-    /// The lag vehicle's desired speed after the trigger, as a multiple of its speed
-    /// at the trigger, in (1, 2].
-    pub speed_ratio: f64,
-}
-
-impl LagAcceleratingConfig {
-    /// Checks every field against its bound; `lane_width` is the road's (m).
-    ///
-    /// # Errors
-    /// [`ConfigError::OutOfRange`] naming `testbed.lag_accelerating.<field>`.
-    pub fn validate(&self, lane_width: f64) -> Result<(), ConfigError> {
-        let field = |name: &str| format!("testbed.lag_accelerating.{name}");
-        let trigger = self.trigger_lateral_m;
-        if !(trigger > 0.0 && trigger <= lane_width) {
-            return Err(crate::config::out_of_range(
-                &field("trigger_lateral_m"),
-                trigger,
-                &format!("in (0, {lane_width:?}] m, within one lane width"),
-            ));
-        }
-        in_range(
-            &field("acceleration_mps2"),
-            self.acceleration_mps2,
-            0.1,
-            MAX_LAG_ACCELERATION_MPS2,
-            &format!("in [0.1, {MAX_LAG_ACCELERATION_MPS2:?}] m/s^2"),
-        )?;
-        let ratio = self.speed_ratio;
-        if !(ratio > 1.0 && ratio <= 2.0) {
-            return Err(crate::config::out_of_range(
-                &field("speed_ratio"),
-                ratio,
-                "in (1, 2]",
-            ));
-        }
-        Ok(())
-    }
-}
-
-/// The state of the accelerating lag vehicle in a scene.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct LagPush {
-    pub(crate) config: LagAcceleratingConfig,
-    /// The ego's lateral position at the start of the scene (m).
-    pub(crate) start_l: f64,
-    /// The index of the vehicle that accelerates, once triggered.
-    pub(crate) pushing: Option<usize>,
-}
 
 impl Scene {
     /// Arms the accelerating lag vehicle of `config` on this scene, the ego's

@@ -43,16 +43,16 @@ mod road;
 mod scene;
 mod testbed;
 pub mod units;
+mod validate;
 mod vehicle;
 
 pub use config::{
-    FollowerConfig, IdmConfig, MAX_SPEED_MPH, PlatoonConfig, PrecedingBrakingConfig,
-    ProfilePointConfig, RoadConfig, ScenarioConfig, SpeedCaseConfig, TestbedConfig, TomlParseError,
-    VehicleConfig, parse_toml,
+    FollowerConfig, IdmConfig, LagAcceleratingConfig, MAX_LAG_ACCELERATION_MPS2, PlatoonConfig,
+    PrecedingBrakingConfig, ProfilePointConfig, RoadConfig, ScenarioConfig, SpeedCaseConfig,
+    TestbedConfig, TomlParseError, VehicleConfig, parse_toml,
 };
 pub use error::{ConfigError, SceneError};
 pub use idm::{BallisticStep, DesiredGap, IdmParams, MIN_INTERACTION_GAP, ballistic_step};
-pub use lag::{LagAcceleratingConfig, MAX_LAG_ACCELERATION_MPS2};
 pub use prediction::{MAX_HORIZON_STEPS, Prediction, PredictionModel};
 pub use road::{Lane, MAX_LANES, Road};
 pub use scene::{MAX_DT, MAX_VEHICLES, Scene};
@@ -60,4 +60,5 @@ pub use testbed::{
     MAX_POSITION_JITTER_M, MAX_PRECEDING_DECELERATION_MPS2, PAPER_ADJACENT_HEADWAYS, SpeedCase,
     TestbedCell,
 };
+pub use validate::MAX_SPEED_MPH;
 pub use vehicle::{Driver, EgoState, SpeedProfile, Vehicle, VehicleId, VehicleState};

@@ -1,11 +1,12 @@
 //! A platoon on one lane behind a scripted leader: the usual experiment for comparing IDM
 //! implementations (a leader's speed profile propagating through the followers).
 
-use crate::config::{ScenarioConfig, in_range, out_of_range, positive, speed_mph};
+use crate::config::ScenarioConfig;
 use crate::error::ConfigError;
 use crate::road::Lane;
 use crate::scene::{MAX_VEHICLES, Scene};
 use crate::units::mph_to_mps;
+use crate::validate::{in_range, out_of_range, positive, speed_mph};
 use crate::vehicle::{Driver, SpeedProfile, Vehicle, VehicleId, VehicleState};
 
 /// Builds the platoon scene: the leader (id 0) at `leader_start_s_m`, followers 1.. behind it

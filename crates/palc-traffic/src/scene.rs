@@ -1,5 +1,6 @@
 //! A scene: the road, its vehicles and the rules that advance them in time.
 
+use crate::config::LagAcceleratingConfig;
 use crate::error::{ConfigError, SceneError};
 use crate::idm::ballistic_step;
 use crate::road::{Lane, Road};
@@ -27,7 +28,17 @@ pub struct Scene {
     pub(crate) preceding: Option<usize>,
     pub(crate) adjacent: Option<usize>,
     /// The accelerating lag vehicle of a stress scene, if armed.
-    pub(crate) lag_push: Option<crate::lag::LagPush>,
+    pub(crate) lag_push: Option<LagPush>,
+}
+
+/// The state of the accelerating lag vehicle in a scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct LagPush {
+    pub(crate) config: LagAcceleratingConfig,
+    /// The ego's lateral position at the start of the scene (m).
+    pub(crate) start_l: f64,
+    /// The index of the vehicle that accelerates, once triggered.
+    pub(crate) pushing: Option<usize>,
 }
 
 impl Scene {
@@ -35,9 +46,9 @@ impl Scene {
     /// roles. The vehicle driven by [`Driver::External`], if any, is the ego; there may be at
     /// most one. IDM decelerations are clipped to `max_braking` (m/s^2, positive).
     pub fn new(road: Road, vehicles: Vec<Vehicle>, max_braking: f64) -> Result<Scene, ConfigError> {
-        crate::config::positive("max_braking", max_braking)?;
+        crate::validate::positive("max_braking", max_braking)?;
         if vehicles.len() > MAX_VEHICLES {
-            return Err(crate::config::out_of_range(
+            return Err(crate::validate::out_of_range(
                 "vehicles",
                 vehicles.len() as f64,
                 &format!("at most {MAX_VEHICLES} vehicles"),
@@ -46,13 +57,13 @@ impl Scene {
         let mut ego = None;
         for (index, vehicle) in vehicles.iter().enumerate() {
             let field = |name: &str| format!("vehicle {}.{name}", vehicle.id.0);
-            crate::config::positive(&field("length"), vehicle.length)?;
-            crate::config::positive(&field("width"), vehicle.width)?;
-            crate::config::in_range(&field("s"), vehicle.state.s, f64::MIN, f64::MAX, "finite")?;
-            crate::config::in_range(&field("l"), vehicle.state.l, f64::MIN, f64::MAX, "finite")?;
-            crate::config::non_negative(&field("v"), vehicle.state.v)?;
+            crate::validate::positive(&field("length"), vehicle.length)?;
+            crate::validate::positive(&field("width"), vehicle.width)?;
+            crate::validate::in_range(&field("s"), vehicle.state.s, f64::MIN, f64::MAX, "finite")?;
+            crate::validate::in_range(&field("l"), vehicle.state.l, f64::MIN, f64::MAX, "finite")?;
+            crate::validate::non_negative(&field("v"), vehicle.state.v)?;
             if vehicle.lane.0 >= road.lanes {
-                return Err(crate::config::out_of_range(
+                return Err(crate::validate::out_of_range(
                     &field("lane"),
                     f64::from(vehicle.lane.0),
                     &format!("below the number of lanes, {}", road.lanes),
@@ -60,7 +71,7 @@ impl Scene {
             }
             if matches!(vehicle.driver, Driver::External { .. }) {
                 if ego.is_some() {
-                    return Err(crate::config::out_of_range(
+                    return Err(crate::validate::out_of_range(
                         &field("driver"),
                         2.0,
                         "at most 1 external (ego) vehicle",
@@ -69,7 +80,7 @@ impl Scene {
                 ego = Some(index);
             }
             if vehicles[..index].iter().any(|other| other.id == vehicle.id) {
-                return Err(crate::config::out_of_range(
+                return Err(crate::validate::out_of_range(
                     &field("id"),
                     f64::from(vehicle.id.0),
                     "unique in the scene",
@@ -141,7 +152,7 @@ impl Scene {
                 .iter()
                 .position(|v| v.id == id && !matches!(v.driver, Driver::External { .. }))
                 .ok_or_else(|| {
-                    crate::config::out_of_range(
+                    crate::validate::out_of_range(
                         field,
                         f64::from(id.0),
                         "a background vehicle of the scene",

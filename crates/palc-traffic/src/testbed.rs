@@ -12,14 +12,12 @@
 //!   spaced by `H` over the whole section `[0, length]`;
 //! - every background vehicle but the preceding one gets a uniform position jitter.
 
-use crate::config::{
-    MAX_SPEED_MPH, PrecedingBrakingConfig, ScenarioConfig, TestbedConfig, in_range, out_of_range,
-    positive,
-};
+use crate::config::{PrecedingBrakingConfig, ScenarioConfig, TestbedConfig};
 use crate::error::ConfigError;
 use crate::road::Lane;
 use crate::scene::{MAX_VEHICLES, Scene};
 use crate::units::{mph_to_mps, mps_to_mph};
+use crate::validate::{MAX_SPEED_MPH, in_range, out_of_range, positive};
 use crate::vehicle::{Driver, SpeedProfile, Vehicle, VehicleId, VehicleState};
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -142,12 +140,12 @@ impl TestbedConfig {
         }
         let mut cases = Vec::with_capacity(self.speed_cases.len());
         for (i, case) in self.speed_cases.iter().enumerate() {
-            crate::config::speed_mph(
+            crate::validate::speed_mph(
                 &format!("testbed.speed_cases[{i}].ego_mph"),
                 case.ego_mph,
                 false,
             )?;
-            crate::config::speed_mph(
+            crate::validate::speed_mph(
                 &format!("testbed.speed_cases[{i}].others_mph"),
                 case.others_mph,
                 false,

@@ -6,7 +6,8 @@
 //! - [`params`]: the named constants of the recursion and the interior point;
 //! - [`recursion`]: the Riccati factorization and solve, terminal rows by a Schur
 //!   complement on their multiplier;
-//! - [`sparse`]: products with `A_i`, `B_i` in the kinematic bicycle's pattern;
+//! - the products with `A_i`, `B_i` in the kinematic bicycle's pattern are those of
+//!   [`StepDynamics`](crate::dynamics::StepDynamics), shared with the assembly;
 //! - [`ipm`]: the interior point (start, predictor, corrector, refinement, stopping
 //!   rule, infeasibility certificate).
 //!
@@ -15,13 +16,11 @@
 mod ipm;
 mod params;
 mod recursion;
-mod sparse;
 
 use crate::backend::{RawSolution, RawStatus};
 use crate::qp::{NX, NZ, Pattern, StageQp};
 
 use ipm::{Ipm, Outcome, Tolerances};
-pub(crate) use sparse::StepDynamics;
 
 /// The Riccati interior-point backend with its buffers, kept between plans.
 #[derive(Debug, Default)]

@@ -30,7 +30,8 @@ use super::params::{
     CONTROL_REGULARIZATION, CONTROL_REGULARIZATION_RELATIVE, TERMINAL_FLOOR, TERMINAL_REFINEMENTS,
     TERMINAL_REGULARIZATION, TERMINAL_TOLERANCE,
 };
-use crate::qp::{Dynamics, NX};
+use crate::dynamics::Dynamics;
+use crate::qp::NX;
 
 /// The terminal rows of every lane change: `v`, `l` and `φ` (Eq. 21; `s` only when
 /// the problem fixes it): `Γ`'s products are specialized to three columns, a fifth
@@ -410,7 +411,7 @@ fn semidefinite(p: Matrix4<f64>) -> Matrix4<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::riccati::StepDynamics;
+    use crate::dynamics::StepDynamics;
 
     /// One step, no terminal rows: the acceleration's row of the Newton system is
     /// solved to rounding however large the steering's diagonal (an active steering

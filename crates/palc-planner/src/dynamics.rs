@@ -1,4 +1,5 @@
-//! Products with the dynamics matrices, exploiting the kinematic bicycle's pattern.
+//! The dynamics of one step of the stage QP (Eqs. 11-14), and products with its
+//! matrices that exploit the kinematic bicycle's pattern.
 //!
 //! Eqs. 11-14 give `A_i = I + N_i` with two entries in `N_i` (`s ← v` and `l ← φ`) and
 //! two in `B_i` (`v ← a` and `φ ← δ`): the dense 4 x 4 products of the Riccati recursion
@@ -7,8 +8,19 @@
 //! instead of the 192 of dense `A`, `B`: one step's dynamics with its offset fills one
 //! cache line), and every product below works on them with fixed positions; a property
 //! test holds each product to the dense one.
+//!
+//! The types live below both the assembly (`qp.rs`) and the Riccati backend
+//! (`riccati/`), which read them; neither imports the other's for them.
 
 use nalgebra::{Matrix4, Matrix4x2, SMatrix, Vector2, Vector4};
+
+/// `X_{i+1} = A X_i + B U_i + c` (Eqs. 11-14); `sparse` holds `A` and `B` in the
+/// cheapest exact form for the products of the recursion.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Dynamics {
+    pub c: Vector4<f64>,
+    pub sparse: StepDynamics,
+}
 
 /// The dynamics matrices of one step,
 /// `A = I + ds e_s e_vᵀ + dl e_l e_φᵀ`, `B = bv e_v e_aᵀ + bphi e_φ e_δᵀ`.
