@@ -150,7 +150,7 @@ impl Executor for HarnessRuns {
                 (row, Some(result.experience))
             }
             Err(HarnessError::Refused { scenario, refusal }) => {
-                let status = Status::refused(&scenario, refusal);
+                let status = Status::refused(&scenario, *refusal);
                 (
                     RunRow::without_result(spec.clone(), status, cap, wall_s),
                     None,

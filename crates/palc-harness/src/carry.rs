@@ -6,13 +6,23 @@ use palc_aggregator::{
     AggregatorError, AggregatorOptions, Experience, Lesson, Representation, StepOutcome,
     learn_from_lesson, plan_problem, resample_weights_shifted,
 };
-use palc_planner::{Planner, Problem, State};
+use palc_planner::{Planner, Problem, State, Weights};
 
 use crate::HarnessError;
-use crate::config::LearnConfig;
 use crate::lesson::scenes;
 use crate::onset::{UserLaneChange, predicted_start_s};
 use crate::setup::Setup;
+
+/// Who and where an experience is learned: the names it is saved with.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Names<'a> {
+    /// The user (its style's name).
+    pub user: &'a str,
+    /// The scenario's label.
+    pub scenario: &'a str,
+    /// The method's name.
+    pub method: &'a str,
+}
 
 /// The experience a run starts from: `previous` carried into this scenario, or a
 /// fresh one with the standard ALC's weights; with it, the user's path to rehearse
@@ -25,31 +35,34 @@ use crate::setup::Setup;
 /// [`latest_planned_start_s`]; the last lesson's path is shifted alike and returned
 /// for [`rehearse`]. Without an observed start, or when none is predicted here, the
 /// weights keep their time base.
+///
+/// A fresh experience holds `standard_weights` (the standard ALC's at this
+/// scenario's horizon) and `names` (user, scenario, method); a carried one takes
+/// the scenario's name.
 pub(crate) fn starting_experience(
-    config: &LearnConfig,
+    names: Names<'_>,
+    standard_weights: &Weights,
     setup: &Setup,
     previous: Option<&Experience>,
     options: &AggregatorOptions,
 ) -> Result<(Experience, Option<Vec<f64>>), HarnessError> {
     let (k, dt) = (setup.horizon, setup.dt);
     let Some(previous) = previous else {
-        let lane_change = setup.standard_lane_change(&config.planning.standard_alc);
-        let weights = config.standard_weights.weights(&lane_change, k, dt);
         let fresh = Experience::new(
-            config.user.style.name(),
-            config.label(),
-            config.method.name(),
-            weights,
+            names.user,
+            names.scenario,
+            names.method,
+            standard_weights.clone(),
             dt,
         )?;
         return Ok((fresh, None));
     };
     let mut carried = previous.clone();
     carried.metadata.dt = dt;
-    carried.metadata.scenario = config.label();
+    names.scenario.clone_into(&mut carried.metadata.scenario);
     let anchored = match (options.representation, previous.anchor_s) {
         (Representation::RelativeOnset, Some(anchor)) => {
-            let settled = settled_duration_s(config, previous, anchor);
+            let settled = settled_duration_s(setup, previous, anchor);
             let latest = latest_planned_start_s(setup, settled);
             // The lane change whose gaps the prediction checks: the model fitted to
             // the demonstration (a quintic settles within 1 % at 88 % of its
@@ -98,12 +111,12 @@ fn latest_planned_start_s(setup: &Setup, duration_s: f64) -> f64 {
 /// until it settles within 1 % of its end. A demonstration that settles before
 /// its own start (none learned yet) says nothing: the standard ALC's duration, the
 /// longest, is assumed instead.
-fn settled_duration_s(config: &LearnConfig, previous: &Experience, anchor_s: f64) -> f64 {
+fn settled_duration_s(setup: &Setup, previous: &Experience, anchor_s: f64) -> f64 {
     (previous.demonstration.as_deref())
         .and_then(|path| settled_s(path, previous.metadata.dt))
         .map(|end| end - anchor_s)
         .filter(|&duration| duration > 0.0)
-        .unwrap_or(config.planning.standard_alc.lane_change_duration_s)
+        .unwrap_or(setup.standard_alc.lane_change_duration_s)
 }
 
 /// The first time (s) from which `path` (step `dt`) stays within 1 % of its last

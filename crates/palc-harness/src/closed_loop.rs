@@ -37,109 +37,15 @@ use palc_aggregator::{AggregatorOptions, Experience, plan_problem};
 use palc_planner::{Plan, Planner, PlannerConfig, Position, State, Terminal, Weights, features};
 use palc_traffic::Scene;
 use palc_zone_filter::StepScene;
-use serde::{Deserialize, Serialize};
 
 use crate::HarnessError;
-use crate::config::LearnConfig;
-use crate::drive::{ego_state, problem};
+use crate::drive::problem;
 use crate::guard::{drive_states, guarded_step};
+use crate::record::ClosedLoopStats;
 use crate::safety::{SafetyMetrics, SafetyMonitor, Violation};
 use crate::setup::Setup;
 
-/// Closed-loop execution (`[planning.closed_loop]`); defaults in `configs/learn.toml`.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct ClosedLoopConfig {
-    /// Whether the lane change is re-planned while it is driven. Off by default:
-    /// the paper's figures use one plan per lane change.
-    pub enabled: bool,
-    /// Time between re-plans (s): a multiple of `planning.dt`, at most the
-    /// horizon. 0.1 s is 10 Hz.
-    pub replan_period_s: f64,
-}
-
-impl Default for ClosedLoopConfig {
-    fn default() -> Self {
-        Self {
-            enabled: false,
-            replan_period_s: 0.1,
-        }
-    }
-}
-
-impl ClosedLoopConfig {
-    /// Checks the period: finite and `> 0`, and, when closed loop is enabled, a
-    /// whole number of steps of `dt` (a disabled table does not hold back a run at
-    /// another step, e.g. the timing experiment's 0.2 s). `table` is the dotted
-    /// path of the table (`planning.closed_loop`).
-    ///
-    /// # Errors
-    /// [`HarnessError::InvalidConfig`] naming `{table}.replan_period_s`.
-    pub fn validate(&self, table: &str, dt: f64) -> Result<(), HarnessError> {
-        let field = format!("{table}.replan_period_s");
-        let period = self.replan_period_s;
-        if !(period.is_finite() && period > 0.0) {
-            return Err(HarnessError::InvalidConfig {
-                field,
-                value: period,
-                bound: "a finite value > 0".to_owned(),
-            });
-        }
-        if !self.enabled {
-            return Ok(());
-        }
-        let steps = period / dt;
-        if !(steps.is_finite() && steps >= 0.5 && (steps - steps.round()).abs() <= 1e-6) {
-            return Err(HarnessError::InvalidConfig {
-                field,
-                value: period,
-                bound: format!("a whole multiple of planning.dt = {dt:?} s"),
-            });
-        }
-        Ok(())
-    }
-
-    /// The period in steps of `dt` (valid after [`ClosedLoopConfig::validate`]).
-    pub fn period_steps(&self, dt: f64) -> usize {
-        ((self.replan_period_s / dt).round() as usize).max(1)
-    }
-
-    /// Checks the period against the horizon of a scenario (`K` steps of `dt`).
-    ///
-    /// # Errors
-    /// [`HarnessError::InvalidConfig`] naming `{table}.replan_period_s` when the
-    /// period is longer than the horizon.
-    pub fn check_horizon(&self, table: &str, dt: f64, horizon: usize) -> Result<(), HarnessError> {
-        if self.period_steps(dt) > horizon {
-            return Err(HarnessError::InvalidConfig {
-                field: format!("{table}.replan_period_s"),
-                value: self.replan_period_s,
-                bound: format!(
-                    "at most the horizon, {horizon} steps of {dt:?} s ({:?} s)",
-                    horizon as f64 * dt
-                ),
-            });
-        }
-        Ok(())
-    }
-}
-
-/// What the closed loop did in one lane change (recorded as
-/// [`crate::LaneChangeRecord::closed_loop`]).
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
-pub struct ClosedLoopStats {
-    /// Re-plans solved and checked (refused ones included).
-    pub replans: usize,
-    /// Re-plans the planner could not solve; the ego kept its current plan.
-    pub replan_failures: usize,
-    /// Re-plans the safety layer refused.
-    pub refusals: usize,
-    /// Step from which the standard ALC's weights drove the lane change, if the
-    /// safety layer fell back to them (0 when the first plan was refused).
-    pub fallback_step: Option<usize>,
-    /// The first refusal.
-    pub first_refusal: Option<Violation>,
-}
+pub use crate::config::ClosedLoopConfig;
 
 /// Which weights a re-plan uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -242,27 +148,25 @@ impl ClosedLoop {
         Ok(())
     }
 
-    /// The closed-loop driver of `config` in the scenario of `setup`, planning with
-    /// `planner`'s settings; `None` when `planning.closed_loop.enabled` is off.
+    /// The closed-loop driver of `closed` in the scenario of `setup`, planning with
+    /// `planner`'s settings and, under the safety layer, falling back to
+    /// `standard_weights`; `None` when `planning.closed_loop.enabled` is off.
     ///
     /// # Errors
     /// [`HarnessError::InvalidConfig`] naming `planning.closed_loop.replan_period_s`
     /// for a period longer than the horizon.
     pub(crate) fn for_config(
-        config: &LearnConfig,
+        closed: ClosedLoopConfig,
+        standard_weights: Option<&Weights>,
         setup: &Setup,
         planner: &PlannerConfig,
     ) -> Result<Option<Self>, HarnessError> {
-        let closed = config.planning.closed_loop;
         if !closed.enabled {
             return Ok(None);
         }
         closed.validate("planning.closed_loop", setup.dt)?;
         closed.check_horizon("planning.closed_loop", setup.dt, setup.horizon)?;
-        let standard = config.planning.safety.enforce.then(|| {
-            let lane_change = setup.standard_lane_change(&config.planning.standard_alc);
-            (config.standard_weights).weights(&lane_change, setup.horizon, setup.dt)
-        });
+        let standard = standard_weights.cloned();
         Self::new(planner.clone(), closed.period_steps(setup.dt), standard).map(Some)
     }
 
@@ -316,7 +220,7 @@ impl ClosedLoop {
                 states.push(next);
                 lateral_violation
                     .push(current.lateral_violation.get(j + 1).copied().unwrap_or(0.0));
-                scene.step(setup.dt, ego_state(setup, &next))?;
+                scene.step(setup.dt, setup.ego_state(&next))?;
             }
             step = until;
             // Re-plan while at least two steps remain.
@@ -493,7 +397,7 @@ fn predict(
     };
     for (i, state) in tail.iter().enumerate() {
         if i > 0 {
-            rollout.step(setup.dt, ego_state(setup, state))?;
+            rollout.step(setup.dt, setup.ego_state(state))?;
         }
         preceding.push(frame(rollout.preceding()));
         adjacent.push(frame(rollout.adjacent()));

@@ -1,7 +1,7 @@
 //! One lane change: plan, execute in the scene, let the user judge each step.
 
 use palc_planner::{LateralBound, Plan, Position, Problem, State, Terminal, Weights};
-use palc_traffic::{EgoState, Scene, ballistic_step};
+use palc_traffic::{Scene, ballistic_step};
 
 use crate::HarnessError;
 use crate::acc::acc_leader;
@@ -169,7 +169,7 @@ pub fn execute(
             }
         };
         if i > 0 {
-            scene.step(dt, ego_state(setup, &state))?;
+            scene.step(dt, setup.ego_state(&state))?;
         }
         if by_user {
             by_user_monitor.observe(i, &scene);
@@ -332,7 +332,7 @@ impl<'a> UserDriving<'a> {
         for j in i..=setup.horizon {
             if j > i {
                 state = self.step(&ahead, &state, j, held).0;
-                ahead.step(setup.dt, ego_state(setup, &state))?;
+                ahead.step(setup.dt, setup.ego_state(&state))?;
             }
             if road.occupies(state.l, width, lane) && !target_gaps_safe(&situation(&ahead), safety)
             {
@@ -364,7 +364,7 @@ fn entering(
         return Ok(None);
     }
     let mut ahead = scene.clone();
-    ahead.step(setup.dt, ego_state(setup, next))?;
+    ahead.step(setup.dt, setup.ego_state(next))?;
     Ok(Some(ahead))
 }
 
@@ -403,7 +403,7 @@ pub(crate) fn own_lane_change_enters_beside(
         if entering(setup, &scene, &previous, &next)?.is_some_and(|ahead| beside(&ahead)) {
             return Ok(Some(i));
         }
-        scene.step(setup.dt, ego_state(setup, &next))?;
+        scene.step(setup.dt, setup.ego_state(&next))?;
         previous = next;
     }
     Ok(None)
@@ -429,16 +429,6 @@ pub(crate) fn states_safety(
         false
     })?;
     Ok(monitor.metrics())
-}
-
-/// The scene's ego state of a plan state (plan frame, `s` from the trigger).
-pub(crate) fn ego_state(setup: &Setup, state: &State) -> EgoState {
-    EgoState {
-        s: state.s + setup.origin_s,
-        l: state.l,
-        v: state.v.max(0.0),
-        heading: state.phi,
-    }
 }
 
 /// The first step from which the driven lateral position stays within 5 cm of the

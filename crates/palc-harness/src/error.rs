@@ -49,8 +49,9 @@ pub enum HarnessError {
     Refused {
         /// Which scenario, e.g. `collector-high / 40 m / seed 1 / neutral`.
         scenario: String,
-        /// What does not hold.
-        refusal: Refusal,
+        /// What does not hold (boxed: a refusal carries its numbers, and errors
+        /// stay small).
+        refusal: Box<Refusal>,
     },
     /// A user of an embedder's own failed.
     #[error("scenario {scenario}: user `{user}` failed")]
@@ -110,7 +111,7 @@ impl HarnessError {
             }
             UserError::Refused { user, refusal } => HarnessError::Refused {
                 scenario: scenario.to_owned(),
-                refusal: Refusal::User { user, refusal },
+                refusal: Box::new(Refusal::User { user, refusal }),
             },
             UserError::Failed { user, source } => HarnessError::UserFailed {
                 scenario: scenario.to_owned(),

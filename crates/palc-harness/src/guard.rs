@@ -32,7 +32,6 @@ use palc_traffic::{Driver, Scene, Vehicle, ballistic_step};
 
 use crate::HarnessError;
 use crate::acc::AccConfig;
-use crate::drive::ego_state;
 use crate::setup::Setup;
 
 impl AccConfig {
@@ -161,7 +160,7 @@ pub(crate) fn drive_states(
     for i in 0..states.len() {
         if i > 0 {
             driven = guarded_step(setup, scene, &driven, &states[i - 1], &states[i]);
-            scene.step(setup.dt, ego_state(setup, &driven))?;
+            scene.step(setup.dt, setup.ego_state(&driven))?;
         }
         if visit(i, &driven, scene) {
             break;

@@ -13,20 +13,20 @@ use palc_aggregator::{
 use palc_planner::{LateralBoundsMode, Plan, Planner, PlannerConfig, Problem};
 
 use crate::HarnessError;
-use crate::carry::{rehearse, starting_experience};
+use crate::carry::{Names, rehearse, starting_experience};
 use crate::closed_loop::ClosedLoop;
 use crate::config::{LearnConfig, StoppingConfig};
 use crate::drive::{
     Drive, execute, judge, own_lane_change_enters_beside, plan_safety, problem, states_safety,
 };
-use crate::learn::{RunResult, aggregator_options, prepare_for};
 use crate::lesson::{lesson, scenes, zone_feature_set};
 use crate::method::Method;
 use crate::observer::{LessonEvent, Observer};
 use crate::onset::{UserLaneChange, onset_at};
-use crate::record::{FrozenEvaluation, LaneChangeRecord, Outcome, RunSummary};
+use crate::record::{FrozenEvaluation, LaneChangeRecord, Outcome, RunResult, RunSummary};
 use crate::refusal::Refusal;
 use crate::safety::{SafetyMetrics, Violation};
+use crate::scenario::{aggregator_options, prepare_for};
 use crate::scene_lessons::SceneLessons;
 use crate::setup::Setup;
 use palc_user::{Expectation, User};
@@ -123,11 +123,11 @@ impl LearningLoop {
         )? {
             return Err(HarnessError::Refused {
                 scenario: config.label(),
-                refusal: Refusal::OwnLaneChangeTakenOver {
+                refusal: Box::new(Refusal::OwnLaneChangeTakenOver {
                     user: user.name().to_owned(),
                     step,
                     cause,
-                },
+                }),
             });
         }
         // Under the longitudinal guard, the user's own lane change driven in the
@@ -139,10 +139,10 @@ impl LearningLoop {
             if own.collision {
                 return Err(HarnessError::Refused {
                     scenario: config.label(),
-                    refusal: Refusal::OwnLaneChangeCollides {
+                    refusal: Box::new(Refusal::OwnLaneChangeCollides {
                         user: user.name().to_owned(),
                         vehicles: collided_with(&own),
-                    },
+                    }),
                 });
             }
         }
@@ -152,15 +152,27 @@ impl LearningLoop {
         if let Some(step) = own_lane_change_enters_beside(&setup, user.as_ref(), &nominal)? {
             return Err(HarnessError::Refused {
                 scenario: config.label(),
-                refusal: Refusal::OwnLaneChangeEntersBeside {
+                refusal: Box::new(Refusal::OwnLaneChangeEntersBeside {
                     user: user.name().to_owned(),
                     step,
-                },
+                }),
             });
         }
         let options = aggregator_options(config);
         options.validate()?;
-        let (experience, rehearsal) = starting_experience(config, &setup, experience, &options)?;
+        // The standard ALC's weights at this scenario's horizon: a fresh
+        // experience's, and the safety layer's fallback.
+        let standard_lane_change = setup.standard_lane_change(&config.planning.standard_alc);
+        let standard_weights =
+            (config.standard_weights).weights(&standard_lane_change, setup.horizon, setup.dt);
+        let label = config.label();
+        let names = Names {
+            user: config.user.style.name(),
+            scenario: &label,
+            method: config.method.name(),
+        };
+        let (experience, rehearsal) =
+            starting_experience(names, &standard_weights, &setup, experience, &options)?;
         let mut planner = Planner::new(PlannerConfig {
             horizon: setup.horizon,
             dt: setup.dt,
@@ -170,18 +182,14 @@ impl LearningLoop {
             },
             ..config.planner.clone()
         })?;
-        let fallback = if config.planning.safety.enforce {
-            let standard = setup.standard_lane_change(&config.planning.standard_alc);
-            let standard_weights =
-                config
-                    .standard_weights
-                    .weights(&standard, setup.horizon, setup.dt);
-            let plan = planner.plan(&problem(&setup, standard_weights, Vec::new()))?;
+        let enforce = config.planning.safety.enforce;
+        let fallback = if enforce {
+            let plan = planner.plan(&problem(&setup, standard_weights.clone(), Vec::new()))?;
             let safety = plan_safety(&setup, &plan)?;
             if let Some(violation) = safety.first_violation {
                 return Err(HarnessError::Refused {
                     scenario: config.label(),
-                    refusal: Refusal::StandardPlanUnsafe { violation },
+                    refusal: Box::new(Refusal::StandardPlanUnsafe { violation }),
                 });
             }
             Some((plan, safety))
@@ -200,7 +208,12 @@ impl LearningLoop {
             &scenes(&setup, None),
             &options,
         )?;
-        let closed_loop = ClosedLoop::for_config(config, &setup, planner.config())?;
+        let closed_loop = ClosedLoop::for_config(
+            config.planning.closed_loop,
+            enforce.then_some(&standard_weights),
+            &setup,
+            planner.config(),
+        )?;
         let started = Instant::now();
         let next_plan = planner.plan(&first_problem)?;
         let pending_times = Timings {
@@ -409,12 +422,12 @@ impl LearningLoop {
         if expectation.lane_change.end_s() > horizon_s + 1e-9 {
             return Err(HarnessError::Refused {
                 scenario: self.label.clone(),
-                refusal: Refusal::DrawBeyondHorizon {
+                refusal: Box::new(Refusal::DrawBeyondHorizon {
                     user: self.user.name().to_owned(),
                     start_s: expectation.lane_change.start_s,
                     duration_s: expectation.lane_change.duration_s,
                     horizon_s,
-                },
+                }),
             });
         }
         let ceiling = if self.user.has_spread() {
@@ -621,6 +634,16 @@ impl LearningLoop {
             frozen: None,
         }
     }
+}
+
+/// Runs the lesson-learning loop of `config`, starting from `experience` if given:
+/// [`LearningLoop::new`] then [`LearningLoop::run`].
+pub fn run(
+    config: &LearnConfig,
+    experience: Option<&Experience>,
+    observer: &mut dyn Observer,
+) -> Result<RunResult, HarnessError> {
+    LearningLoop::new(config, experience)?.run(observer)
 }
 
 /// The counters [`termination`] reads besides the records.

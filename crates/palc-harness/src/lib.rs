@@ -37,7 +37,6 @@ mod config;
 mod drive;
 mod error;
 mod guard;
-mod learn;
 mod learning_loop;
 mod lesson;
 mod method;
@@ -46,31 +45,36 @@ mod onset;
 mod record;
 mod refusal;
 pub mod safety;
+mod scenario;
 mod scene_lessons;
 mod setup;
 mod standard_alc;
+mod violation;
 
 /// The users: the [`User`] trait, its plain view of a scenario and the built-in
 /// simulated users (the `palc-user` crate).
 pub use palc_user as user;
 
 pub use acc::AccConfig;
-pub use closed_loop::{ClosedLoopConfig, ClosedLoopStats};
+
 pub use config::{
-    CellChoice, LearnConfig, MAX_LANE_CHANGES, MAX_SUCCESS_STREAK, MAX_TAKEOVERS, StoppingConfig,
-    UserConfig, UserStyle,
+    CellChoice, ClosedLoopConfig, LearnConfig, MAX_LANE_CHANGES, MAX_SUCCESS_STREAK, MAX_TAKEOVERS,
+    PlanningConfig, StoppingConfig, UserConfig, UserStyle,
 };
 pub use error::HarnessError;
-pub use learn::{RunResult, aggregator_options, expectation, prepare, run};
 pub use learning_loop::LearningLoop;
+pub use learning_loop::run;
 pub use method::Method;
 pub use observer::{LessonEvent, NoObserver, Observer};
 pub use palc_aggregator::Timings;
 pub use palc_user::{Family, SimulatedUser, StylePreset, User, UserScene};
-pub use record::{FrozenEvaluation, LaneChangeRecord, Outcome, RunSummary, Takeover};
+pub use record::{
+    ClosedLoopStats, FrozenEvaluation, LaneChangeRecord, Outcome, RunResult, RunSummary, Takeover,
+};
 pub use refusal::Refusal;
 pub use safety::{SafetyConfig, SafetyMetrics, SafetyMonitor, Violation};
-pub use setup::{PlanningConfig, Setup};
+pub use scenario::{aggregator_options, expectation, prepare};
+pub use setup::Setup;
 pub use standard_alc::StandardWeights;
 
 /// The loop's building blocks, for those who drive their own loop or test one

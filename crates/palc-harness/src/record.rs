@@ -1,9 +1,9 @@
 //! What the loop reports: one record per lane change and a summary per run.
 
-use palc_aggregator::Timings;
+use palc_aggregator::{Experience, Timings};
 use serde::{Deserialize, Serialize};
 
-use crate::closed_loop::ClosedLoopStats;
+use crate::method::Method;
 use crate::safety::{SafetyMetrics, Violation};
 use palc_user::TakeoverCause;
 
@@ -160,6 +160,23 @@ impl RunSummary {
     }
 }
 
+/// What the closed loop did in one lane change (recorded as
+/// [`crate::LaneChangeRecord::closed_loop`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+pub struct ClosedLoopStats {
+    /// Re-plans solved and checked (refused ones included).
+    pub replans: usize,
+    /// Re-plans the planner could not solve; the ego kept its current plan.
+    pub replan_failures: usize,
+    /// Re-plans the safety layer refused.
+    pub refusals: usize,
+    /// Step from which the standard ALC's weights drove the lane change, if the
+    /// safety layer fell back to them (0 when the first plan was refused).
+    pub fallback_step: Option<usize>,
+    /// The first refusal.
+    pub first_refusal: Option<Violation>,
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -202,4 +219,23 @@ mod tests {
             prop_assert!(failed >= cap);
         }
     }
+}
+
+/// Everything a run produced.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct RunResult {
+    /// The scenario, e.g. `collector-high / 40 m / seed 1 / neutral`.
+    pub label: String,
+    /// The method.
+    pub method: Method,
+    /// Planning horizon K of this scenario.
+    pub horizon: usize,
+    /// Step (s).
+    pub dt: f64,
+    /// How the run ended.
+    pub summary: RunSummary,
+    /// One record per lane change.
+    pub records: Vec<LaneChangeRecord>,
+    /// What was learned, to be saved or carried into another scenario.
+    pub experience: Experience,
 }

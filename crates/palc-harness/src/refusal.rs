@@ -11,7 +11,7 @@ use palc_user::{TakeoverCause, UserRefusal};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::safety::Violation;
+use crate::violation::Violation;
 
 /// Why a scenario does not fit the planning set-up.
 #[derive(Debug, Clone, PartialEq, Error, Serialize, Deserialize)]

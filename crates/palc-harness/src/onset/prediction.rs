@@ -630,7 +630,7 @@ mod tests {
                     headway_m: 45.0,
                     seed: 1,
                 });
-            crate::learn::prepare(&config).unwrap()
+            crate::scenario::prepare(&config).unwrap()
         })
     }
 

@@ -1,39 +1,16 @@
-//! The front door of the lesson-learning loop (paper Fig. 2): preparing a
-//! scenario, the options of a method, and [`run`], the one-call form of
-//! [`LearningLoop`].
+//! Preparing a scenario from a config: the traffic scene of its cell, the
+//! planning set-up at the trigger with the paper's premise checked in it
+//! ([`prepare`]), and a user's nominal lane change with the horizon extended to
+//! cover it.
 
-use palc_aggregator::{AggregatorOptions, Experience};
+use palc_aggregator::AggregatorOptions;
 use palc_traffic::Scene;
-use serde::{Deserialize, Serialize};
+use palc_user::{Expectation, StylePreset, User};
 
 use crate::HarnessError;
 use crate::config::LearnConfig;
-use crate::learning_loop::LearningLoop;
-use crate::method::Method;
-use crate::observer::Observer;
-use crate::record::{LaneChangeRecord, RunSummary};
 use crate::refusal::Refusal;
 use crate::setup::Setup;
-use palc_user::{Expectation, StylePreset, User};
-
-/// Everything a run produced.
-#[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct RunResult {
-    /// The scenario, e.g. `collector-high / 40 m / seed 1 / neutral`.
-    pub label: String,
-    /// The method.
-    pub method: Method,
-    /// Planning horizon K of this scenario.
-    pub horizon: usize,
-    /// Step (s).
-    pub dt: f64,
-    /// How the run ended.
-    pub summary: RunSummary,
-    /// One record per lane change.
-    pub records: Vec<LaneChangeRecord>,
-    /// What was learned, to be saved or carried into another scenario.
-    pub experience: Experience,
-}
 
 /// The aggregator options of a config: its own table if given, else the method's.
 pub fn aggregator_options(config: &LearnConfig) -> AggregatorOptions {
@@ -55,7 +32,7 @@ pub fn prepare(config: &LearnConfig) -> Result<Setup, HarnessError> {
         .check_conservative(&config.planning.standard_alc, &StylePreset::ALL)
         .map_err(|refusal: Refusal| HarnessError::Refused {
             scenario: label,
-            refusal,
+            refusal: Box::new(refusal),
         })?;
     Ok(setup)
 }
@@ -87,14 +64,4 @@ pub(crate) fn prepare_for(
         config.planning.horizon_margin_s,
     )?;
     Ok((setup, nominal))
-}
-
-/// Runs the lesson-learning loop of `config`, starting from `experience` if given:
-/// [`LearningLoop::new`] then [`LearningLoop::run`].
-pub fn run(
-    config: &LearnConfig,
-    experience: Option<&Experience>,
-    observer: &mut dyn Observer,
-) -> Result<RunResult, HarnessError> {
-    LearningLoop::new(config, experience)?.run(observer)
 }

@@ -1,4 +1,12 @@
-//! The configuration of a learning run, as read from TOML (`configs/learn.toml`).
+//! The configuration of a learning run, as read from TOML (`configs/learn.toml`),
+//! with its tables: the planning set-up ([`PlanningConfig`]) and closed loop
+//! ([`ClosedLoopConfig`]).
+
+mod closed_loop;
+mod planning;
+
+pub use closed_loop::ClosedLoopConfig;
+pub use planning::PlanningConfig;
 
 use palc_planner::PlannerConfig;
 use palc_traffic::{ScenarioConfig, TestbedCell};
@@ -6,7 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::HarnessError;
 use crate::method::Method;
-use crate::setup::PlanningConfig;
+
 use crate::standard_alc::StandardWeights;
 use palc_user::{Family, SimulatedUser, Spread, Style, StylePreset};
 
@@ -371,7 +379,7 @@ impl LearnConfig {
 mod tests {
     use super::*;
 
-    const DEFAULT: &str = include_str!("../../../configs/learn.toml");
+    const DEFAULT: &str = include_str!("../../../../configs/learn.toml");
 
     fn user(text: &str) -> Result<UserConfig, toml::de::Error> {
         toml::from_str(text)
