@@ -190,13 +190,13 @@ pub fn learn_from_lesson(
         convex_set: &options.convex_set,
     };
     let mut candidate = plan_problem.clone();
-    let outcome = options
-        .correction
-        .rule()
-        .correct(&input, state, &mut |w: &Weights| {
-            candidate.weights = w.clone();
-            planner.plan(&candidate)
-        })?;
+    let (outcome, apprenticeship) =
+        options
+            .correction
+            .correct(&input, state, &mut |w: &Weights| {
+                candidate.weights = w.clone();
+                planner.plan(&candidate)
+            })?;
     timings.correction_s = start.elapsed().as_secs_f64();
 
     let start = Instant::now();
@@ -219,7 +219,7 @@ pub fn learn_from_lesson(
             metadata,
             weights: outcome.weights,
             zone,
-            apprenticeship: outcome.apprenticeship,
+            apprenticeship,
             anchor_s: experience.anchor_s,
             onsets: experience.onsets.clone(),
             demonstration: Some(expert.states.iter().map(|x| x.l).collect()),

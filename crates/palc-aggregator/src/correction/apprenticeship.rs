@@ -41,6 +41,9 @@ pub struct ApprenticeshipState {
 pub struct ApprenticeshipRule {}
 
 impl RewardCorrection for ApprenticeshipRule {
+    /// The projection point `μ̄`, kept between lessons.
+    type State = ApprenticeshipState;
+
     fn name(&self) -> &'static str {
         "apprenticeship"
     }
@@ -50,7 +53,7 @@ impl RewardCorrection for ApprenticeshipRule {
         input: &CorrectionInput<'_>,
         state: Option<&ApprenticeshipState>,
         _plan: &mut dyn FnMut(&Weights) -> Result<Plan, PlanError>,
-    ) -> Result<CorrectionOutcome, AggregatorError> {
+    ) -> Result<CorrectionOutcome<ApprenticeshipState>, AggregatorError> {
         check_horizons(input)?;
         let k = input.weights.horizon();
         let sigma = &input.scale.0;
@@ -114,10 +117,10 @@ impl RewardCorrection for ApprenticeshipRule {
         )?;
         Ok(CorrectionOutcome {
             weights,
-            apprenticeship: Some(ApprenticeshipState {
+            state: ApprenticeshipState {
                 mu_bar,
                 updates: previous.map_or(0, |s| s.updates) + 1,
-            }),
+            },
             error_before: None,
             error_after: None,
             plan: None,

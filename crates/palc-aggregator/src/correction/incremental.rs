@@ -4,9 +4,7 @@
 use palc_planner::{FEATURE_COUNT, Features, Plan, PlanError, Weights};
 use serde::{Deserialize, Serialize};
 
-use super::{
-    ApprenticeshipState, CorrectionInput, CorrectionOutcome, RewardCorrection, check_horizons,
-};
+use super::{CorrectionInput, CorrectionOutcome, RewardCorrection, check_horizons};
 use crate::{AggregatorError, feature_error, project_convex};
 
 /// Projected feature-matching steps from the *current* weights:
@@ -80,6 +78,9 @@ impl IncrementalRule {
 }
 
 impl RewardCorrection for IncrementalRule {
+    /// Nothing is kept between lessons: each starts from the current weights.
+    type State = ();
+
     fn name(&self) -> &'static str {
         "incremental"
     }
@@ -87,7 +88,7 @@ impl RewardCorrection for IncrementalRule {
     fn correct(
         &self,
         input: &CorrectionInput<'_>,
-        state: Option<&ApprenticeshipState>,
+        _state: Option<&()>,
         plan: &mut dyn FnMut(&Weights) -> Result<Plan, PlanError>,
     ) -> Result<CorrectionOutcome, AggregatorError> {
         self.validate()?;
@@ -150,7 +151,7 @@ impl RewardCorrection for IncrementalRule {
         }
         Ok(CorrectionOutcome {
             weights: best_weights,
-            apprenticeship: state.cloned(),
+            state: (),
             error_before: Some(before),
             error_after: Some(best_error),
             inner_solves: solves,

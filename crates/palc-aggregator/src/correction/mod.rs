@@ -35,13 +35,15 @@ pub struct CorrectionInput<'a> {
     pub convex_set: &'a ConvexSet,
 }
 
-/// What a correction rule returns.
+/// What a correction rule returns; `S` is the rule's own state
+/// ([`RewardCorrection::State`]).
 #[derive(Debug, Clone, PartialEq)]
-pub struct CorrectionOutcome {
+pub struct CorrectionOutcome<S = ()> {
     /// The corrected weights; in the convex set.
     pub weights: Weights,
-    /// New apprenticeship state (projection point), when the rule keeps one.
-    pub apprenticeship: Option<ApprenticeshipState>,
+    /// The rule's state after this lesson, to give to its next lesson (the
+    /// projection point of [`ApprenticeshipRule`]; `()` for a rule that keeps none).
+    pub state: S,
     /// Scaled feature error of the plan with the *current* weights against the expert,
     /// when the rule measured it (incremental rule).
     pub error_before: Option<f64>,
@@ -56,11 +58,40 @@ pub struct CorrectionOutcome {
     pub plan: Option<Plan>,
 }
 
+impl<S> CorrectionOutcome<S> {
+    /// The outcome without the rule's state, and the state.
+    pub fn split_state(self) -> (CorrectionOutcome, S) {
+        let CorrectionOutcome {
+            weights,
+            state,
+            error_before,
+            error_after,
+            inner_solves,
+            plan,
+        } = self;
+        let outcome = CorrectionOutcome {
+            weights,
+            state: (),
+            error_before,
+            error_after,
+            inner_solves,
+            plan,
+        };
+        (outcome, state)
+    }
+}
+
 /// A reward correction rule: turns a lesson's features into one new weight matrix.
 ///
 /// `plan` solves the next plan's problem with candidate weights (the same planner and
-/// problem as the final plan), for rules that measure their effect.
+/// problem as the final plan), for rules that measure their effect. A rule that
+/// carries something from one lesson to the next names its type as
+/// [`RewardCorrection::State`]: it receives the state its last lesson returned
+/// (`None` at the first lesson, or when the caller dropped it) and returns the next.
 pub trait RewardCorrection {
+    /// What the rule keeps between lessons; `()` when it keeps nothing.
+    type State;
+
     /// A short name for reports (`apprenticeship`, `incremental`).
     fn name(&self) -> &'static str;
 
@@ -68,9 +99,9 @@ pub trait RewardCorrection {
     fn correct(
         &self,
         input: &CorrectionInput<'_>,
-        state: Option<&ApprenticeshipState>,
+        state: Option<&Self::State>,
         plan: &mut dyn FnMut(&Weights) -> Result<Plan, PlanError>,
-    ) -> Result<CorrectionOutcome, AggregatorError>;
+    ) -> Result<CorrectionOutcome<Self::State>, AggregatorError>;
 }
 
 /// Which correction rule the step uses.
@@ -92,12 +123,37 @@ impl Default for CorrectionRule {
 }
 
 impl CorrectionRule {
-    /// The rule behind the option.
-    pub fn rule(&self) -> &dyn RewardCorrection {
+    /// The rule's short name ([`RewardCorrection::name`]).
+    pub fn name(&self) -> &'static str {
         match self {
-            CorrectionRule::Apprenticeship(r) => r,
-            CorrectionRule::Incremental(r) => r,
-            CorrectionRule::Target(r) => r,
+            CorrectionRule::Apprenticeship(r) => r.name(),
+            CorrectionRule::Incremental(r) => r.name(),
+            CorrectionRule::Target(r) => r.name(),
+        }
+    }
+
+    /// Corrects the weights with the rule behind the option.
+    ///
+    /// `apprenticeship` is the projection point the experience keeps: the
+    /// apprenticeship rule reads it and returns the next one; the other rules keep
+    /// no state, and it is returned unchanged.
+    pub fn correct(
+        &self,
+        input: &CorrectionInput<'_>,
+        apprenticeship: Option<&ApprenticeshipState>,
+        plan: &mut dyn FnMut(&Weights) -> Result<Plan, PlanError>,
+    ) -> Result<(CorrectionOutcome, Option<ApprenticeshipState>), AggregatorError> {
+        match self {
+            CorrectionRule::Apprenticeship(r) => {
+                let (outcome, state) = r.correct(input, apprenticeship, plan)?.split_state();
+                Ok((outcome, Some(state)))
+            }
+            CorrectionRule::Incremental(r) => {
+                Ok((r.correct(input, None, plan)?, apprenticeship.cloned()))
+            }
+            CorrectionRule::Target(r) => {
+                Ok((r.correct(input, None, plan)?, apprenticeship.cloned()))
+            }
         }
     }
 }

@@ -3,9 +3,7 @@
 use palc_planner::{Features, Plan, PlanError, Weights, feature};
 use serde::{Deserialize, Serialize};
 
-use super::{
-    ApprenticeshipState, CorrectionInput, CorrectionOutcome, RewardCorrection, check_horizons,
-};
+use super::{CorrectionInput, CorrectionOutcome, RewardCorrection, check_horizons};
 use crate::{AggregatorError, feature_error, project_convex};
 
 /// Iterative learning control on the lateral target of every stage.
@@ -88,6 +86,9 @@ fn lateral_error(plan: &Features, expert: &Features) -> f64 {
 }
 
 impl RewardCorrection for TargetRule {
+    /// Nothing is kept between lessons: each starts from the current weights.
+    type State = ();
+
     fn name(&self) -> &'static str {
         "target"
     }
@@ -95,7 +96,7 @@ impl RewardCorrection for TargetRule {
     fn correct(
         &self,
         input: &CorrectionInput<'_>,
-        state: Option<&ApprenticeshipState>,
+        _state: Option<&()>,
         plan: &mut dyn FnMut(&Weights) -> Result<Plan, PlanError>,
     ) -> Result<CorrectionOutcome, AggregatorError> {
         self.validate()?;
@@ -146,7 +147,7 @@ impl RewardCorrection for TargetRule {
         Ok(CorrectionOutcome {
             error_after: scaled(&best_plan.features),
             weights: best_weights,
-            apprenticeship: state.cloned(),
+            state: (),
             error_before: before,
             inner_solves: solves,
             plan: Some(best_plan),
