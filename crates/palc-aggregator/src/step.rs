@@ -44,6 +44,19 @@ impl Timings {
         ]
     }
 
+    /// The timings of the parts in the order of [`Timings::PART_NAMES`] (s): the
+    /// inverse of [`Timings::parts`].
+    pub fn from_parts(parts: [f64; 5]) -> Timings {
+        let [zone_fit_s, bounds_s, expert_s, correction_s, plan_s] = parts;
+        Timings {
+            zone_fit_s,
+            bounds_s,
+            expert_s,
+            correction_s,
+            plan_s,
+        }
+    }
+
     /// Sum of the parts (s).
     pub fn total_s(&self) -> f64 {
         self.parts().iter().sum()

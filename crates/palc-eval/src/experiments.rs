@@ -2,13 +2,13 @@
 
 use std::path::Path;
 
-use palc_harness::Method;
+use palc_harness::{Method, Timings};
 
 use crate::EvalError;
 use crate::figures::{self, Bars, Example, Lines};
 use crate::harness_runs::ExampleTrace;
 use crate::plan::Experiment;
-use crate::results::{PART_NAMES, RunRow};
+use crate::results::RunRow;
 use crate::stats;
 use crate::transfer_report::{Axis, accumulation_places, matrix_pairs};
 use crate::views::{FigureFile, grid, slug, speed_label, timing, with_transfer};
@@ -289,14 +289,14 @@ pub fn draw_all(
             title: "Compute time per iteration by part (mean)".into(),
             x_desc: "part of the iteration".into(),
             y_desc: "mean time per iteration (ms)".into(),
-            categories: PART_NAMES.iter().map(|s| s.to_string()).collect(),
+            categories: Timings::PART_NAMES.iter().map(|s| s.to_string()).collect(),
             series: methods
                 .iter()
                 .filter_map(|&m| {
                     let t = stats::timing(timing(rows, m))?;
                     Some((
                         m.name().to_owned(),
-                        t.part_means.iter().map(|v| Some(v * 1e3)).collect(),
+                        t.part_means.parts().iter().map(|v| Some(v * 1e3)).collect(),
                     ))
                 })
                 .collect(),

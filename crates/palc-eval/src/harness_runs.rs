@@ -213,7 +213,7 @@ impl Observer for RowRecorder {
                 .is_some_and(|t| matches!(t.cause, TakeoverCause::PerceivedSafety { .. })),
             perceived_safety_ratio: record.perceived_safety_ratio,
             max_deviation_m: record.max_deviation_m,
-            times_s: record.times.parts(),
+            times_s: record.times,
             learning_error: None,
             safety: record.safety,
             user_safety: record.user_safety,

@@ -88,8 +88,10 @@ pub struct Iteration {
     pub perceived_safety_ratio: f64,
     /// Largest `|planned − expected|` (m).
     pub max_deviation_m: f64,
-    /// Compute time by part: zone fit, bounds, expert, correction, plan (s).
-    pub times_s: [f64; 5],
+    /// Compute time by part (s); `runs.json` files that hold it as an array in the
+    /// order of [`Timings::PART_NAMES`] read too.
+    #[serde(deserialize_with = "timings_or_parts")]
+    pub times_s: Timings,
     /// Why the lesson of this lane change could not be learned, if it could not.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub learning_error: Option<String>,
@@ -107,15 +109,27 @@ pub struct Iteration {
     pub closed_loop: Option<ClosedLoopStats>,
 }
 
-use palc_harness::{ClosedLoopStats, FrozenEvaluation, Refusal, SafetyMetrics, Violation};
+use palc_harness::{ClosedLoopStats, FrozenEvaluation, Refusal, SafetyMetrics, Timings, Violation};
 
-/// Names of the parts of [`Iteration::times_s`].
-pub const PART_NAMES: [&str; 5] = palc_harness::Timings::PART_NAMES;
+/// Reads [`Iteration::times_s`] as written (the named parts of [`Timings`]) or as
+/// older `runs.json` files hold it (an array in the order of [`Timings::PART_NAMES`]).
+fn timings_or_parts<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Timings, D::Error> {
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum Stored {
+        Named(Timings),
+        Parts([f64; 5]),
+    }
+    Ok(match Stored::deserialize(d)? {
+        Stored::Named(timings) => timings,
+        Stored::Parts(parts) => Timings::from_parts(parts),
+    })
+}
 
 impl Iteration {
     /// Total compute time of the iteration (s).
     pub fn total_s(&self) -> f64 {
-        self.times_s.iter().sum()
+        self.times_s.total_s()
     }
 }
 
@@ -214,7 +228,7 @@ impl RunRow {
         let mut row = self.clone();
         row.wall_s = 0.0;
         for iteration in &mut row.iterations {
-            iteration.times_s = [0.0; 5];
+            iteration.times_s = Timings::default();
         }
         row
     }
@@ -384,6 +398,18 @@ mod tests {
         assert_eq!(back.len(), rows.len());
         assert_eq!(back[0].spec, rows[0].spec);
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn times_read_back_as_named_parts_and_as_an_old_array() {
+        let iteration = synthetic_rows().remove(0).iterations.remove(0);
+        let json = serde_json::to_value(&iteration).unwrap();
+        let back: Iteration = serde_json::from_value(json.clone()).unwrap();
+        assert_eq!(back, iteration);
+        let mut old = json;
+        old["times_s"] = serde_json::json!(iteration.times_s.parts());
+        let back: Iteration = serde_json::from_value(old).unwrap();
+        assert_eq!(back, iteration);
     }
 
     #[test]

@@ -215,13 +215,13 @@ pub(crate) mod tests {
                         1.0
                     },
                     max_deviation_m: 0.1,
-                    times_s: [
-                        0.001,
-                        0.002,
-                        0.01,
-                        0.02,
-                        0.005 * spec.dt.unwrap_or(0.1) * 10.0,
-                    ],
+                    times_s: palc_harness::Timings {
+                        zone_fit_s: 0.001,
+                        bounds_s: 0.002,
+                        expert_s: 0.01,
+                        correction_s: 0.02,
+                        plan_s: 0.005 * spec.dt.unwrap_or(0.1) * 10.0,
+                    },
                     learning_error: None,
                     safety: Default::default(),
                     user_safety: Default::default(),

@@ -4,11 +4,11 @@
 
 use std::collections::HashMap;
 
-use palc_harness::StylePreset;
+use palc_harness::{StylePreset, Timings};
 use serde::Serialize;
 
 use crate::plan::{CellKey, Experiment};
-use crate::results::{Iteration, PART_NAMES, RunRow};
+use crate::results::{Iteration, RunRow};
 
 /// Takeover statistics of a set of runs; refused runs are counted apart.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -213,10 +213,10 @@ pub struct Timing {
     pub p95: f64,
     /// Largest total time.
     pub max: f64,
-    /// Mean time of each part ([`PART_NAMES`]).
-    pub part_means: [f64; 5],
+    /// Mean time of each part.
+    pub part_means: Timings,
     /// 95th percentile of each part.
-    pub part_p95: [f64; 5],
+    pub part_p95: Timings,
 }
 
 /// Nearest-rank percentile `q ∈ [0, 1]` of sorted values.
@@ -246,10 +246,10 @@ pub fn timing_of(iterations: &[&Iteration]) -> Option<Timing> {
     };
     let totals = sorted(&Iteration::total_s);
     let n = iterations.len() as f64;
-    let mut part_means = [0.0; PART_NAMES.len()];
-    let mut part_p95 = [0.0; PART_NAMES.len()];
-    for p in 0..PART_NAMES.len() {
-        let values = sorted(&|it: &Iteration| it.times_s[p]);
+    let mut part_means = [0.0; Timings::PART_NAMES.len()];
+    let mut part_p95 = [0.0; Timings::PART_NAMES.len()];
+    for p in 0..Timings::PART_NAMES.len() {
+        let values = sorted(&|it: &Iteration| it.times_s.parts()[p]);
         part_means[p] = values.iter().sum::<f64>() / n;
         part_p95[p] = percentile(&values, 0.95);
     }
@@ -259,8 +259,8 @@ pub fn timing_of(iterations: &[&Iteration]) -> Option<Timing> {
         p50: percentile(&totals, 0.5),
         p95: percentile(&totals, 0.95),
         max: totals[totals.len() - 1],
-        part_means,
-        part_p95,
+        part_means: Timings::from_parts(part_means),
+        part_p95: Timings::from_parts(part_p95),
     })
 }
 

@@ -11,10 +11,10 @@
 
 use std::fmt::Write as _;
 
-use palc_harness::Method;
+use palc_harness::{Method, Timings};
 
 use crate::plan::Experiment;
-use crate::results::{Iteration, PART_NAMES, RunRow};
+use crate::results::{Iteration, RunRow};
 use crate::stats::{self, Timing};
 use crate::views;
 
@@ -122,7 +122,7 @@ fn verdict(t: &Timing) -> String {
 
 /// A table header whose first columns are `first`, then the timing columns.
 fn header(out: &mut String, first: &str) {
-    let parts = PART_NAMES.map(|p| format!("{p} mean"));
+    let parts = Timings::PART_NAMES.map(|p| format!("{p} mean"));
     let columns = first.matches('|').count() + 1 + 5 + parts.len();
     let _ = writeln!(
         out,
@@ -143,7 +143,7 @@ fn line(out: &mut String, label: &str, t: &Timing) {
         ms(t.p50),
         ms(t.p95),
         ms(t.max),
-        t.part_means.map(ms).join(" | ")
+        t.part_means.parts().map(ms).join(" | ")
     );
 }
 
@@ -158,8 +158,8 @@ mod tests {
             p50: mean_ms * 1e-3,
             p95: p95_ms * 1e-3,
             max: p95_ms * 1e-3,
-            part_means: [0.0; 5],
-            part_p95: [0.0; 5],
+            part_means: Timings::default(),
+            part_p95: Timings::default(),
         }
     }
 
