@@ -1,4 +1,5 @@
-//! Figures as SVG and PNG with `plotters`.
+//! Figures as SVG and PNG with `plotters`, drawn in memory and written through
+//! the atomic writer like every other output.
 //!
 //! Text goes through plotters' pure-Rust `ab_glyph` path with the bundled
 //! DejaVu Sans (assets/, Bitstream Vera licence), so that a machine with
@@ -7,6 +8,8 @@
 
 use std::path::{Path, PathBuf};
 
+use image::codecs::png::PngEncoder;
+use image::{ColorType, ImageEncoder};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use plotters::style::register_font;
@@ -50,7 +53,9 @@ pub trait Figure {
     fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult;
 }
 
-/// Writes `stem.svg` and `stem.png` under `dir`; returns both paths.
+/// Writes `stem.svg` and `stem.png` under `dir` through the atomic writer
+/// ([`palc_aggregator::output::write`], like every other output); returns both paths.
+/// Both are drawn in memory first, so a figure that cannot be drawn writes nothing.
 pub fn save<F: Figure>(
     dir: &Path,
     stem: &str,
@@ -59,27 +64,39 @@ pub fn save<F: Figure>(
 ) -> Result<[PathBuf; 2], EvalError> {
     let svg = dir.join(format!("{stem}.svg"));
     let png = dir.join(format!("{stem}.png"));
-    draw_both(&svg, &png, size, figure).map_err(|message| EvalError::Figure {
+    let (svg_text, png_bytes) = render(size, figure).map_err(|message| EvalError::Figure {
         figure: stem.to_owned(),
         message,
     })?;
+    palc_aggregator::output::write(&svg, svg_text.as_bytes())?;
+    palc_aggregator::output::write(&png, &png_bytes)?;
     Ok([svg, png])
 }
 
-fn draw_both<F: Figure>(svg: &Path, png: &Path, size: (u32, u32), figure: &F) -> DrawResult {
+/// Draws `figure` as an SVG document (plotters' string backend) and as a PNG file's
+/// bytes: drawn on an in-memory RGB buffer, encoded by the `image` crate's PNG encoder
+/// with its defaults, as plotters' file backend encodes it.
+fn render<F: Figure>(size: (u32, u32), figure: &F) -> Result<(String, Vec<u8>), String> {
+    let mut svg = String::new();
     {
-        let root = SVGBackend::new(&svg, size).into_drawing_area();
+        let root = SVGBackend::with_string(&mut svg, size).into_drawing_area();
         root.fill(&WHITE).map_err(plot_error)?;
         figure.draw(&root)?;
         root.present().map_err(plot_error)?;
     }
+    let (width, height) = size;
+    let mut pixels = vec![0; width as usize * height as usize * 3];
     {
-        let root = BitMapBackend::new(&png, size).into_drawing_area();
+        let root = BitMapBackend::with_buffer(&mut pixels, size).into_drawing_area();
         root.fill(&WHITE).map_err(plot_error)?;
         figure.draw(&root)?;
         root.present().map_err(plot_error)?;
     }
-    Ok(())
+    let mut png = Vec::new();
+    PngEncoder::new(&mut png)
+        .write_image(&pixels, width, height, ColorType::Rgb8)
+        .map_err(plot_error)?;
+    Ok((svg, png))
 }
 
 /// Grouped bars: one group per category, one bar per series; a missing value
