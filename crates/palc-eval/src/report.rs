@@ -61,6 +61,7 @@ pub fn render(input: &ReportInput) -> String {
              its statistics are not the reproduction. Run `cargo xtask reproduce-paper` for the full grid.\n"
         );
     }
+    summary_section(&mut out, input);
     for user in input.users {
         user_section(&mut out, input, user);
     }
@@ -78,12 +79,62 @@ pub fn render(input: &ReportInput) -> String {
     for figure in input.figures {
         let _ = writeln!(
             out,
-            "{}\n\n![{}]({}.svg)\n\n([PNG]({}.png))\n",
+            "{} ([PNG]({}.png))\n![{}]({}.svg)\n",
             figure.caption, figure.stem, figure.stem, figure.stem
         );
     }
     manifest_section(&mut out, m);
     out
+}
+
+/// One screen before the details: how many runs were counted, refused and
+/// failed, and per user kind and method the grid's success, mean takeovers and
+/// the reduction with experience from the next speed case.
+fn summary_section(out: &mut String, input: &ReportInput) {
+    let rows = input.rows;
+    let refused = rows.iter().filter(|r| !r.status.counted()).count();
+    let failed = (rows.iter())
+        .filter(|r| matches!(r.status, Status::Failed { .. }))
+        .count();
+    let _ = writeln!(out, "## Summary\n");
+    let _ = writeln!(
+        out,
+        "{} runs: {} counted, {refused} refused before running (their kinds in \"Refused scenarios \
+         and failed runs\"), {failed} of the counted stopped on an error (counted at the cap). \
+         The grid, per user kind and method (failures at the cap):\n",
+        rows.len(),
+        rows.len() - refused
+    );
+    let _ = writeln!(
+        out,
+        "| users | method | personalized | mean takeovers | with experience from the next speed case |"
+    );
+    let _ = writeln!(out, "| --- | --- | --- | --- | --- |");
+    for user in input.users {
+        for &method in input.methods {
+            let summary = Summary::of(grid(rows, method, user));
+            let transfer = crate::stats::transfer(&with_transfer(rows, method, user));
+            let experience = match (transfer.without, transfer.with, transfer.reduction) {
+                (Some(without), Some(with), Some(reduction)) => format!(
+                    "{} -> {} ({:.0} % fewer, {} cells)",
+                    num(Some(without), 1),
+                    num(Some(with), 1),
+                    reduction * 100.0,
+                    transfer.pairs
+                ),
+                _ => "n/a".to_owned(),
+            };
+            let _ = writeln!(
+                out,
+                "| {user} | `{}` | {}/{} | {} | {experience} |",
+                method.name(),
+                summary.personalized,
+                summary.runs,
+                num(summary.mean, 1),
+            );
+        }
+    }
+    let _ = writeln!(out);
 }
 
 fn user_section(out: &mut String, input: &ReportInput, user: &str) {
@@ -366,10 +417,63 @@ fn refusals(out: &mut String, rows: &[RunRow]) {
         }
         let _ = writeln!(out);
     }
+    failed_runs(out, &failed);
+}
+
+/// Runs that stopped on an error, counted by the error's kind (its first two
+/// clauses) and experiment, each kind with one example; every one is in
+/// `runs.csv` with its message.
+fn failed_runs(out: &mut String, failed: &[&RunRow]) {
+    if failed.is_empty() {
+        return;
+    }
+    let mut experiments: Vec<&str> = Vec::new();
+    let mut kinds: Vec<(&str, String)> = Vec::new();
     for row in failed {
-        if let Status::Failed { error } = &row.status {
-            let _ = writeln!(out, "- failed: `{}`: {error}", row.spec.label());
+        let Status::Failed { error } = &row.status else {
+            continue;
+        };
+        let experiment = row.spec.experiment.name();
+        if !experiments.contains(&experiment) {
+            experiments.push(experiment);
         }
+        let kind = cause_kind(error);
+        if !kinds.iter().any(|(k, _)| *k == kind) {
+            kinds.push((kind, format!("`{}`: {error}", row.spec.label())));
+        }
+    }
+    let kind_of = |row: &RunRow| match &row.status {
+        Status::Failed { error } => Some(cause_kind(error).to_owned()),
+        _ => None,
+    };
+    let _ = writeln!(
+        out,
+        "Runs that stopped on an error, by the error's kind (the full messages are in `runs.csv`):\n"
+    );
+    let _ = writeln!(
+        out,
+        "| error | {} | total | example |",
+        experiments.join(" | ")
+    );
+    let _ = writeln!(out, "|{}", " --- |".repeat(experiments.len() + 3));
+    for (kind, example) in &kinds {
+        let count = |experiment: Option<&str>| {
+            (failed.iter())
+                .filter(|r| kind_of(r).as_deref() == Some(*kind))
+                .filter(|r| experiment.is_none_or(|e| r.spec.experiment.name() == e))
+                .count()
+        };
+        let cells: Vec<String> = (experiments.iter())
+            .map(|e| count(Some(e)).to_string())
+            .collect();
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} |",
+            kind.replace('|', "\\|"),
+            cells.join(" | "),
+            count(None),
+            example.replace('|', "\\|")
+        );
     }
     let _ = writeln!(out);
 }
@@ -570,7 +674,11 @@ mod tests {
         // The synthetic paper method never personalizes: 30 everywhere, 117 % above 13.8.
         assert!(report.contains("paper: 117 % higher"), "{report}");
         assert!(report.contains("takeover reduction with experience"));
-        assert!(report.contains("the standard ALC is not conservative"));
+        assert!(report.contains("## Summary"));
+        // Refusals are counted by kind and experiment, with one example each.
+        assert!(report.contains("| kind | grid |"), "{report}");
+        assert!(report.contains("| `standard-not-slower` |"), "{report}");
+        assert!(report.contains("is not slower than the cautious user's (3.5 s)"));
         let refused = rows.iter().filter(|r| !r.status.counted()).count();
         assert!(report.contains(&format!("{refused} of {} runs were refused", rows.len())));
         assert!(report.contains("**This is the `--quick` subset**"));

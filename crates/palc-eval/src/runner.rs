@@ -190,10 +190,14 @@ pub(crate) mod tests {
                     return (
                         RunRow::without_result(
                             spec.clone(),
-                            Status::Refused {
-                                reason: "the standard ALC is not conservative".into(),
-                                refusal: None,
-                            },
+                            Status::refused(
+                                "synthetic",
+                                palc_harness::Refusal::StandardNotSlower {
+                                    standard_duration_s: 3.5,
+                                    style: "cautious".into(),
+                                    user_duration_s: 3.5,
+                                },
+                            ),
                             30,
                             0.0,
                         ),
