@@ -154,10 +154,7 @@ impl ExpertGenerator for LessonExpert {
             }
         }
         check_weight(FIELDS[2], self.tracking[2])?;
-        let reference = input
-            .lesson
-            .executed
-            .iter()
+        let reference = (input.lesson.demonstrated().iter())
             .enumerate()
             .map(|(i, x)| (i > 0).then_some(*x))
             .collect();

@@ -14,6 +14,10 @@ pub struct Lesson {
     /// The executed trajectory, steps `0..=K` (length `K + 1`): the system's part up to
     /// `takeover_step`, then the user's part.
     pub executed: Vec<State>,
+    /// What the lesson demonstrates, derived from `executed` by the method (e.g. the
+    /// user's whole lane change fitted before the takeover), steps `0..=K`; `None`
+    /// when it demonstrates what was driven. The lesson expert tracks it.
+    pub demonstration: Option<Vec<State>>,
     /// The first step driven by the user (`0..=K`).
     pub takeover_step: usize,
     /// The lesson's labelled samples for the zone model. The caller labels them: the
@@ -26,6 +30,12 @@ pub struct Lesson {
 }
 
 impl Lesson {
+    /// The trajectory the lesson demonstrates: [`Lesson::demonstration`], else
+    /// what was driven.
+    pub fn demonstrated(&self) -> &[State] {
+        self.demonstration.as_deref().unwrap_or(&self.executed)
+    }
+
     /// Checks the lengths against the horizon `K` and that the executed states are finite.
     pub(crate) fn validate(&self, horizon: usize, use_zone: bool) -> Result<(), AggregatorError> {
         let mismatch = |field, expected, found| {
@@ -40,6 +50,9 @@ impl Lesson {
             }
         };
         mismatch("executed", horizon + 1, self.executed.len())?;
+        if let Some(demonstration) = &self.demonstration {
+            mismatch("demonstration", horizon + 1, demonstration.len())?;
+        }
         mismatch("planned.controls", horizon, self.planned.controls.len())?;
         mismatch("planned.features", horizon, self.planned.features.horizon())?;
         if use_zone {
@@ -52,13 +65,19 @@ impl Lesson {
                 bound: "at most the horizon K",
             });
         }
-        for (i, x) in self.executed.iter().enumerate() {
-            for (name, value) in [("s", x.s), ("v", x.v), ("l", x.l), ("phi", x.phi)] {
-                if !value.is_finite() {
-                    return Err(AggregatorError::NonFinite {
-                        field: format!("executed[{i}].{name}"),
-                        value,
-                    });
+        let demonstrated = self.demonstration.iter().map(|d| ("demonstration", d));
+        for (field, states) in [("executed", &self.executed)]
+            .into_iter()
+            .chain(demonstrated)
+        {
+            for (i, x) in states.iter().enumerate() {
+                for (name, value) in [("s", x.s), ("v", x.v), ("l", x.l), ("phi", x.phi)] {
+                    if !value.is_finite() {
+                        return Err(AggregatorError::NonFinite {
+                            field: format!("{field}[{i}].{name}"),
+                            value,
+                        });
+                    }
                 }
             }
         }

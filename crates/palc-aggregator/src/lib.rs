@@ -8,7 +8,7 @@
 //!    and projected onto lateral bounds, when [`AggregatorOptions::use_zone`] is set;
 //! 2. an [`ExpertGenerator`] builds the expert problem, planned by the same
 //!    [`palc_planner::Planner`] with its tracking term: [`ZoneCentreExpert`] (the paper,
-//!    Eqs. 24-26) or [`LessonExpert`] (the executed trajectory, re-planned);
+//!    Eqs. 24-26) or [`LessonExpert`] (the lesson's demonstration, re-planned);
 //! 3. a [`RewardCorrection`] rule returns one new weight matrix:
 //!    [`ApprenticeshipRule`] (Abbeel & Ng's projection method, Eqs. 33-36),
 //!    [`IncrementalRule`] (projected feature-matching steps from the current
@@ -52,7 +52,14 @@
 //! let executed = (0..=k)
 //!     .map(|i| if i < takeover_step { planned.states[i] } else { user_states[i] })
 //!     .collect();
-//! let lesson = Lesson { planned, executed, takeover_step, samples: vec![], step_scenes: vec![] };
+//! let lesson = Lesson {
+//!     planned,
+//!     executed,
+//!     demonstration: None,
+//!     takeover_step,
+//!     samples: vec![],
+//!     step_scenes: vec![],
+//! };
 //!
 //! let experience = Experience::new("user-1", "45-40mph", "palc", standard, 0.2)?;
 //! let options = AggregatorOptions::default(); // lesson expert, target rule on w1, w2

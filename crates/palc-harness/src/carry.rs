@@ -3,8 +3,8 @@
 //! space, and a rehearsal of the user's path in the new scene's dynamics.
 
 use palc_aggregator::{
-    AggregatorError, AggregatorOptions, Experience, Lesson, Representation, StepOutcome,
-    learn_from_lesson, plan_problem, resample_weights_shifted,
+    AggregatorError, AggregatorOptions, Experience, Lesson, StepOutcome, learn_from_lesson,
+    plan_problem, resample_weights_shifted,
 };
 use palc_planner::{Planner, Problem, State, Weights};
 
@@ -15,7 +15,7 @@ use crate::setup::Setup;
 
 /// Who and where an experience is learned: the names it is saved with.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Names<'a> {
+pub struct Names<'a> {
     /// The user (its style's name).
     pub user: &'a str,
     /// The scenario's label.
@@ -28,8 +28,8 @@ pub(crate) struct Names<'a> {
 /// fresh one with the standard ALC's weights; with it, the user's path to rehearse
 /// in this scene when there is one.
 ///
-/// The weights are resampled to this scenario's horizon and step. With
-/// [`Representation::RelativeOnset`] and a user's start observed before, they are
+/// The weights are resampled to this scenario's horizon and step. When `relative`
+/// (experience in relative space) and a user's start was observed before, they are
 /// also shifted so that the learned start falls where this scene predicts the
 /// relative state the user started in ([`predicted_start_s`]), held no later than
 /// [`latest_planned_start_s`]; the last lesson's path is shifted alike and returned
@@ -44,7 +44,7 @@ pub(crate) fn starting_experience(
     standard_weights: &Weights,
     setup: &Setup,
     previous: Option<&Experience>,
-    options: &AggregatorOptions,
+    relative: bool,
 ) -> Result<(Experience, Option<Vec<f64>>), HarnessError> {
     let (k, dt) = (setup.horizon, setup.dt);
     let Some(previous) = previous else {
@@ -60,8 +60,8 @@ pub(crate) fn starting_experience(
     let mut carried = previous.clone();
     carried.metadata.dt = dt;
     names.scenario.clone_into(&mut carried.metadata.scenario);
-    let anchored = match (options.representation, previous.anchor_s) {
-        (Representation::RelativeOnset, Some(anchor)) => {
+    let anchored = match (relative, previous.anchor_s) {
+        (true, Some(anchor)) => {
             let settled = settled_duration_s(setup, previous, anchor);
             let latest = latest_planned_start_s(setup, settled);
             // The lane change whose gaps the prediction checks: the model fitted to
@@ -181,6 +181,7 @@ pub(crate) fn rehearse(
             step_scenes: scenes(setup, Some(&planned.states)),
             planned,
             executed,
+            demonstration: None,
             takeover_step: 0,
             samples: Vec::new(),
         };

@@ -67,6 +67,7 @@ pub(crate) fn lesson(
     Ok(Lesson {
         planned: drive.plan.clone(),
         executed: drive.driven.clone(),
+        demonstration: None,
         takeover_step,
         samples,
         step_scenes: scenes(setup, Some(&drive.plan.states)),

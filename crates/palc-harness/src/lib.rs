@@ -42,6 +42,7 @@ mod lesson;
 mod method;
 mod observer;
 mod onset;
+mod personalization;
 mod record;
 mod refusal;
 pub mod safety;
@@ -83,6 +84,11 @@ pub use standard_alc::StandardWeights;
 /// [`LearningLoop`] composes them; most embedders need only that.
 pub mod advanced {
     pub use crate::acc::acc_leader;
+    pub use crate::carry::Names;
     pub use crate::drive::{Drive, execute, judge, plan_safety, problem};
     pub use crate::method::{Driver, label};
+    pub use crate::personalization::{
+        Demonstration, LessonPaths, Personalization, RelativeOnset, Replay, SceneAveraged,
+        for_options,
+    };
 }

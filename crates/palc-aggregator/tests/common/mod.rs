@@ -122,6 +122,7 @@ pub fn lesson(
     Lesson {
         planned,
         executed,
+        demonstration: None,
         takeover_step,
         samples,
         step_scenes,

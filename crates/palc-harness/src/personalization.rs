@@ -1,0 +1,228 @@
+//! How a method personalizes (paper Section II.C; docs/paper-mapping.md, "The two
+//! methods"): what a lesson demonstrates, what an accepted lane change tells, and
+//! how experience is carried into a new scene. The loop asks a [`Personalization`]
+//! and switches on no flag of its own.
+//!
+//! Three implementations compose every method and ablation rung
+//! ([`for_options`]):
+//!
+//! | implementation | demonstration | carried into a new scene |
+//! | --- | --- | --- |
+//! | [`Replay`] (the paper's) | what was driven | weights resampled, same time base |
+//! | [`RelativeOnset`] (palc's) | the user's whole lane change, fitted before the takeover | anchored at the user's start predicted in relative space |
+//! | [`SceneAveraged`] around either | the mean of the scene's lessons in the gap its lane changes point to | as the inner one |
+
+use std::fmt;
+
+use palc_aggregator::{AggregatorOptions, Experience, Representation};
+use palc_planner::Weights;
+
+use crate::HarnessError;
+use crate::carry::{self, Names};
+use crate::onset::{UserLaneChange, onset_at};
+use crate::scene_lessons::SceneLessons;
+use crate::setup::Setup;
+
+/// The lateral paths of one taken-over lane change, at steps `0..=K` of `dt`.
+#[derive(Debug, Clone, Copy)]
+pub struct LessonPaths<'a> {
+    /// What was driven: the system up to the takeover, then the user.
+    pub driven_l: &'a [f64],
+    /// The plan that was taken over.
+    pub planned_l: &'a [f64],
+    /// The first step the user drove.
+    pub takeover_step: usize,
+    /// Step (s).
+    pub dt: f64,
+    /// The target lane's centre (m).
+    pub target_l: f64,
+}
+
+/// What a lesson teaches.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Demonstration {
+    /// The lateral path (m, steps `0..=K`) the expert follows; `None` for what was
+    /// driven.
+    pub path: Option<Vec<f64>>,
+    /// The user's start (s) when the lesson shows where the user starts in this
+    /// scene; recorded in the experience once the lesson is learned.
+    pub start_s: Option<f64>,
+}
+
+/// How a method turns lessons into demonstrations and carries what it learned.
+pub trait Personalization: fmt::Debug + Send {
+    /// The demonstration of a taken-over lane change.
+    fn demonstrate(&mut self, lesson: &LessonPaths<'_>) -> Demonstration;
+
+    /// A lane change the user accepted (no takeover), its driven lateral path at
+    /// steps of `dt`; by default it tells nothing.
+    fn accepted(&mut self, _driven_l: &[f64], _dt: f64, _target_l: f64) {}
+
+    /// The experience a run starts from in `setup`: `previous` carried into it
+    /// (with the user's path to rehearse there, if any), or a fresh one holding
+    /// the standard ALC's weights. By default the weights keep their time base.
+    ///
+    /// # Errors
+    /// Resampling errors of the aggregator.
+    fn carry(
+        &self,
+        names: Names<'_>,
+        standard_weights: &Weights,
+        setup: &Setup,
+        previous: Option<&Experience>,
+    ) -> Result<(Experience, Option<Vec<f64>>), HarnessError> {
+        carry::starting_experience(names, standard_weights, setup, previous, false)
+    }
+
+    /// Records the user's start `start_s` seen in a lesson of `setup` in the
+    /// experience: merged into this scene's onset, which becomes the anchor of
+    /// the weights.
+    fn observe_start(&self, experience: &mut Experience, setup: &Setup, start_s: f64) {
+        record_onset(experience, setup, start_s);
+    }
+}
+
+/// The implementations a method's options compose: [`Replay`] or
+/// [`RelativeOnset`] by `representation`, inside [`SceneAveraged`] with
+/// `average_lessons`.
+pub fn for_options(options: &AggregatorOptions) -> Box<dyn Personalization> {
+    match (options.representation, options.average_lessons) {
+        (Representation::TimeIndexed, false) => Box::new(Replay),
+        (Representation::TimeIndexed, true) => Box::new(SceneAveraged::new(Replay)),
+        (Representation::RelativeOnset, false) => Box::new(RelativeOnset),
+        (Representation::RelativeOnset, true) => Box::new(SceneAveraged::new(RelativeOnset)),
+    }
+}
+
+/// The paper's personalization: the expert follows what was driven, and the
+/// weights carry with their time base.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Replay;
+
+impl Personalization for Replay {
+    fn demonstrate(&mut self, lesson: &LessonPaths<'_>) -> Demonstration {
+        Demonstration {
+            path: None,
+            start_s: fit(lesson).map(|user| user.start_s),
+        }
+    }
+}
+
+/// palc's personalization in relative space (docs/paper-mapping.md, "Experience
+/// in relative space"): the expert follows the user's whole lane change (before
+/// the takeover, the model fitted to what the user drove after it), and the
+/// weights carry anchored at the start predicted in the new scene.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct RelativeOnset;
+
+impl Personalization for RelativeOnset {
+    fn demonstrate(&mut self, lesson: &LessonPaths<'_>) -> Demonstration {
+        match fit(lesson) {
+            Some(user) => Demonstration {
+                path: Some(user.path(lesson.driven_l, lesson.takeover_step, lesson.dt)),
+                start_s: Some(user.start_s),
+            },
+            None => Demonstration::default(),
+        }
+    }
+
+    fn carry(
+        &self,
+        names: Names<'_>,
+        standard_weights: &Weights,
+        setup: &Setup,
+        previous: Option<&Experience>,
+    ) -> Result<(Experience, Option<Vec<f64>>), HarnessError> {
+        carry::starting_experience(names, standard_weights, setup, previous, true)
+    }
+}
+
+/// The mean of the scene's lessons (`average_lessons`; docs/paper-mapping.md,
+/// "Users with spread"): the expert of a lesson follows the mean of the inner
+/// demonstrations that started in the gap the scene's lane changes point to; a
+/// lesson into another gap keeps the plan and shows no start.
+#[derive(Debug, Clone, Default)]
+pub struct SceneAveraged<P> {
+    inner: P,
+    lessons: SceneLessons,
+}
+
+impl<P> SceneAveraged<P> {
+    /// Averages the demonstrations of `inner`.
+    pub fn new(inner: P) -> Self {
+        SceneAveraged {
+            inner,
+            lessons: SceneLessons::default(),
+        }
+    }
+}
+
+impl<P: Personalization> Personalization for SceneAveraged<P> {
+    fn demonstrate(&mut self, lesson: &LessonPaths<'_>) -> Demonstration {
+        let inner = self.inner.demonstrate(lesson);
+        let Some(user) = fit(lesson) else {
+            return inner;
+        };
+        let path = (inner.path).unwrap_or_else(|| lesson.driven_l.to_vec());
+        let mean = self.lessons.add(user, path, lesson.dt);
+        Demonstration {
+            path: Some(mean.path.unwrap_or_else(|| lesson.planned_l.to_vec())),
+            start_s: inner.start_s.filter(|_| mean.includes_lesson),
+        }
+    }
+
+    /// Counts the lane change's start: it tells which gap the user takes.
+    fn accepted(&mut self, driven_l: &[f64], dt: f64, target_l: f64) {
+        if let Some(driven) = UserLaneChange::fit(driven_l, 0, dt, target_l) {
+            self.lessons.accept(driven.start_s);
+        }
+        self.inner.accepted(driven_l, dt, target_l);
+    }
+
+    fn carry(
+        &self,
+        names: Names<'_>,
+        standard_weights: &Weights,
+        setup: &Setup,
+        previous: Option<&Experience>,
+    ) -> Result<(Experience, Option<Vec<f64>>), HarnessError> {
+        self.inner.carry(names, standard_weights, setup, previous)
+    }
+
+    fn observe_start(&self, experience: &mut Experience, setup: &Setup, start_s: f64) {
+        self.inner.observe_start(experience, setup, start_s);
+    }
+}
+
+/// The user's own lane change fitted to what it drove after the takeover.
+fn fit(lesson: &LessonPaths<'_>) -> Option<UserLaneChange> {
+    UserLaneChange::fit(
+        lesson.driven_l,
+        lesson.takeover_step,
+        lesson.dt,
+        lesson.target_l,
+    )
+}
+
+/// Merges the start `start_s` seen in `setup` into this scene's onset (the last
+/// of `experience.onsets` when it is this scene's), which becomes the anchor of
+/// the weights; the onsets of earlier scenes tell which waits were for the
+/// leader's gap.
+fn record_onset(experience: &mut Experience, setup: &Setup, start_s: f64) {
+    let onsets = &mut experience.onsets;
+    let this_scene = if onsets.last().is_some_and(|o| o.scenario == setup.label) {
+        onsets.pop()
+    } else {
+        None
+    };
+    let Some(observed) = onset_at(setup, start_s, onsets) else {
+        onsets.extend(this_scene);
+        return;
+    };
+    let merged = match this_scene {
+        Some(last) => last.merged(&observed),
+        None => observed,
+    };
+    experience.anchor_s = Some(merged.time_s);
+    onsets.push(merged);
+}
