@@ -14,7 +14,7 @@
 use std::path::{Path, PathBuf};
 
 use palc_harness::user::ParameterSpread;
-use palc_harness::{Family, Method, StylePreset};
+use palc_harness::{Method, StylePreset, user::Family};
 use palc_traffic::{SpeedCaseConfig, TestbedConfig};
 use serde::{Deserialize, Serialize};
 
@@ -109,7 +109,7 @@ pub struct UserKind {
     /// draws are seeded with the scene's seed.
     #[serde(default)]
     pub spread_parameters: Option<ParameterSpread>,
-    /// The family that refines each style (`palc_harness::Family`: start rule,
+    /// The family that refines each style (`palc_harness::user::Family`: start rule,
     /// reaction, lateral profile, speed, perceived-safety takeover); the paper's
     /// user when left out.
     #[serde(default)]

@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use palc_harness::{Method, Timings};
+use palc_harness::{Method, record::Timings};
 
 use crate::EvalError;
 use crate::figures::{self, Bars, Example, Lines};

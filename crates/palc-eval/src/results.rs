@@ -109,7 +109,11 @@ pub struct Iteration {
     pub closed_loop: Option<ClosedLoopStats>,
 }
 
-use palc_harness::{ClosedLoopStats, FrozenEvaluation, Refusal, SafetyMetrics, Timings, Violation};
+use palc_harness::{
+    Refusal,
+    record::{ClosedLoopStats, FrozenEvaluation, Timings},
+    safety::{SafetyMetrics, Violation},
+};
 
 /// Reads [`Iteration::times_s`] as written (the named parts of [`Timings`]) or as
 /// older `runs.json` files hold it (an array in the order of [`Timings::PART_NAMES`]).

@@ -219,7 +219,7 @@ pub(crate) mod tests {
                         1.0
                     },
                     max_deviation_m: 0.1,
-                    times_s: palc_harness::Timings {
+                    times_s: palc_harness::record::Timings {
                         zone_fit_s: 0.001,
                         bounds_s: 0.002,
                         expert_s: 0.01,

@@ -4,7 +4,7 @@
 
 use std::fmt::Write as _;
 
-use palc_harness::{Method, SafetyMetrics};
+use palc_harness::{Method, safety::SafetyMetrics};
 
 use crate::plan::Experiment;
 use crate::results::{Iteration, RunRow};

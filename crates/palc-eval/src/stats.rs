@@ -4,7 +4,7 @@
 
 use std::collections::HashMap;
 
-use palc_harness::{StylePreset, Timings};
+use palc_harness::{StylePreset, record::Timings};
 use serde::Serialize;
 
 use crate::plan::{CellKey, Experiment};

@@ -11,7 +11,7 @@
 
 use std::fmt::Write as _;
 
-use palc_harness::{Method, Timings};
+use palc_harness::{Method, record::Timings};
 
 use crate::plan::Experiment;
 use crate::results::{Iteration, RunRow};

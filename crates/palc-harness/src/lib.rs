@@ -33,7 +33,7 @@
 mod acc;
 mod carry;
 pub mod closed_loop;
-mod config;
+pub mod config;
 mod drive;
 mod error;
 mod guard;
@@ -43,7 +43,7 @@ mod method;
 mod observer;
 mod onset;
 mod personalization;
-mod record;
+pub mod record;
 mod refusal;
 pub mod safety;
 mod scenario;
@@ -56,27 +56,16 @@ mod violation;
 /// simulated users (the `palc-user` crate).
 pub use palc_user as user;
 
-pub use acc::AccConfig;
-
-pub use config::{
-    CellChoice, ClosedLoopConfig, LearnConfig, MAX_LANE_CHANGES, MAX_SUCCESS_STREAK, MAX_TAKEOVERS,
-    PlanningConfig, StoppingConfig, UserConfig, UserStyle,
-};
+pub use config::{CellChoice, LearnConfig, UserConfig};
 pub use error::HarnessError;
-pub use learning_loop::LearningLoop;
-pub use learning_loop::run;
+pub use learning_loop::{LearningLoop, run};
 pub use method::Method;
 pub use observer::{LessonEvent, NoObserver, Observer};
-pub use palc_aggregator::Timings;
-pub use palc_user::{Family, SimulatedUser, StylePreset, User, UserScene};
-pub use record::{
-    ClosedLoopStats, FrozenEvaluation, LaneChangeRecord, Outcome, RunResult, RunSummary, Takeover,
-};
+pub use palc_user::{StylePreset, User, UserScene};
+pub use record::{LaneChangeRecord, Outcome, RunResult, RunSummary};
 pub use refusal::Refusal;
-pub use safety::{SafetyConfig, SafetyMetrics, SafetyMonitor, Violation};
-pub use scenario::{aggregator_options, expectation, prepare};
+pub use scenario::prepare;
 pub use setup::Setup;
-pub use standard_alc::StandardWeights;
 
 /// The loop's building blocks, for those who drive their own loop or test one
 /// part of it: the planning problem of a scenario, the execution of a plan with a
@@ -91,4 +80,5 @@ pub mod advanced {
         Demonstration, LessonPaths, Personalization, RelativeOnset, Replay, SceneAveraged,
         for_options,
     };
+    pub use crate::scenario::{aggregator_options, expectation};
 }

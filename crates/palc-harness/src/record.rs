@@ -1,6 +1,9 @@
-//! What the loop reports: one record per lane change and a summary per run.
+//! What the loop reports: one record per lane change (with what closed loop did
+//! and the compute time by part, [`Timings`]) and a summary per run.
 
-use palc_aggregator::{Experience, Timings};
+pub use palc_aggregator::Timings;
+
+use palc_aggregator::Experience;
 use serde::{Deserialize, Serialize};
 
 use crate::method::Method;

@@ -39,7 +39,7 @@ pub fn prepare(config: &LearnConfig) -> Result<Setup, HarnessError> {
 
 /// The scenario of `config` with its user's nominal expected lane change: what a
 /// user wants before learning starts (`palc user expect`). The horizon covers the
-/// lane change, as in [`LearningLoop::new`].
+/// lane change, as in [`crate::LearningLoop::new`].
 ///
 /// # Errors
 /// As [`prepare`], or a user without a sane lane change in the scenario.

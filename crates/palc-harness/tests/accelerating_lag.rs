@@ -5,7 +5,8 @@
 
 use palc_harness::safety::Role;
 use palc_harness::{
-    LaneChangeRecord, LearnConfig, LearningLoop, Observer, StylePreset, UserConfig, Violation,
+    LaneChangeRecord, LearnConfig, LearningLoop, Observer, StylePreset, UserConfig,
+    safety::Violation,
 };
 
 const STRESS: &str = include_str!("../../../configs/stress/accelerating-lag.toml");

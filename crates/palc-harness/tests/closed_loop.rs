@@ -7,7 +7,10 @@ use palc_harness::advanced::{execute, problem};
 use palc_harness::closed_loop::ClosedLoop;
 use palc_harness::user::{SimulatedUser, User};
 use palc_harness::{
-    ClosedLoopStats, LearnConfig, PlanningConfig, Setup, StandardWeights, StylePreset, Violation,
+    LearnConfig, Setup, StylePreset,
+    config::{PlanningConfig, StandardWeights},
+    record::ClosedLoopStats,
+    safety::Violation,
 };
 use palc_planner::{Planner, PlannerConfig};
 use palc_traffic::{

@@ -192,7 +192,8 @@ fn a_user_holds_beside_the_follower_and_a_scene_where_its_own_lane_change_would_
     );
     // The user, taking over a plan that keeps the lane at the lane-keeping speeds
     // of its own lane change, holds rather than steer into the follower.
-    let (setup, nominal) = palc_harness::expectation(&config).expect("the scene prepares");
+    let (setup, nominal) =
+        palc_harness::advanced::expectation(&config).expect("the scene prepares");
     let user = (config.user)
         .simulated(config.planning.takeover_threshold_m)
         .expect("the user builds");

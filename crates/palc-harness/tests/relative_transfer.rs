@@ -4,7 +4,8 @@
 
 use palc_aggregator::{AggregatorOptions, Representation};
 use palc_harness::{
-    CellChoice, LearnConfig, LearningLoop, NoObserver, StylePreset, UserConfig, expectation, run,
+    CellChoice, LearnConfig, LearningLoop, NoObserver, StylePreset, UserConfig,
+    advanced::expectation, run,
 };
 
 fn config(speed_case: &str, headway_m: f64, style: StylePreset) -> LearnConfig {

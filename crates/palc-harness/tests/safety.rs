@@ -3,7 +3,10 @@
 //! measures must flag, and the record's new fields through JSON.
 
 use palc_harness::advanced::acc_leader;
-use palc_harness::{AccConfig, SafetyConfig, SafetyMetrics, SafetyMonitor};
+use palc_harness::{
+    config::{AccConfig, SafetyConfig},
+    safety::{SafetyMetrics, SafetyMonitor},
+};
 use palc_traffic::{
     Driver, EgoState, IdmParams, Lane, Road, Scene, SpeedProfile, Vehicle, VehicleId, VehicleState,
     ballistic_step,
@@ -217,7 +220,7 @@ fn safety_metrics_round_trip_through_json() {
         min_ttc_target_lag_s: Some(3.25),
         collision: false,
         rss_violations: 2,
-        first_violation: Some(palc_harness::Violation {
+        first_violation: Some(palc_harness::safety::Violation {
             step: 37,
             role: palc_harness::safety::Role::TargetLag,
             vehicle: 4,
@@ -233,7 +236,9 @@ fn safety_metrics_round_trip_through_json() {
 
 #[test]
 fn with_the_safety_layer_on_no_driven_plan_is_unsafe_and_every_refusal_is_recorded() {
-    use palc_harness::{LearnConfig, LearningLoop, Method, NoObserver, Observer, Violation};
+    use palc_harness::{
+        LearnConfig, LearningLoop, Method, NoObserver, Observer, safety::Violation,
+    };
 
     #[derive(Default)]
     struct Refusals(Vec<(usize, Violation)>);
@@ -275,7 +280,7 @@ fn with_the_safety_layer_on_no_driven_plan_is_unsafe_and_every_refusal_is_record
 
 #[test]
 fn users_who_wait_for_safe_gaps_start_at_the_safe_distance_and_never_earlier() {
-    use palc_harness::{CellChoice, LearnConfig, StylePreset, UserConfig, expectation};
+    use palc_harness::{CellChoice, LearnConfig, StylePreset, UserConfig, advanced::expectation};
 
     let text = include_str!("../../../configs/learn-safe.toml");
     let base = LearnConfig::from_toml_str(text).expect("the safe config parses");

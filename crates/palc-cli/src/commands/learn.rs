@@ -7,7 +7,7 @@ use clap::Args;
 use palc_aggregator::{Experience, output};
 use palc_harness::{
     CellChoice, LaneChangeRecord, LearnConfig, LessonEvent, Method, Observer, RunSummary,
-    UserConfig, UserStyle, run,
+    UserConfig, config::UserStyle, run,
 };
 
 use crate::console::say;

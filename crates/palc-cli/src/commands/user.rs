@@ -43,7 +43,7 @@ pub fn run(args: UserArgs) -> anyhow::Result<()> {
 
 fn expect(args: ExpectArgs) -> anyhow::Result<()> {
     let config = load_config(&args.scenario)?;
-    let (setup, expectation) = palc_harness::expectation(&config)?;
+    let (setup, expectation) = palc_harness::advanced::expectation(&config)?;
     let lane_change = &expectation.lane_change;
     let mut csv = String::from("step,time_s,s_m,v_mps,l_m,phi_rad,phase\n");
     for (i, state) in expectation

@@ -44,7 +44,7 @@ impl Fixture {
         }
         let experience = run.experience().clone();
         let plan: Plan = run.next_plan().clone();
-        let options = palc_harness::aggregator_options(&config);
+        let options = palc_harness::advanced::aggregator_options(&config);
         let planner = PlannerConfig {
             horizon: setup.horizon,
             dt: setup.dt,

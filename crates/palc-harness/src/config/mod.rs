@@ -5,6 +5,9 @@
 mod closed_loop;
 mod planning;
 
+pub use crate::acc::AccConfig;
+pub use crate::safety::SafetyConfig;
+pub use crate::standard_alc::StandardWeights;
 pub use closed_loop::ClosedLoopConfig;
 pub use planning::PlanningConfig;
 
@@ -15,7 +18,6 @@ use serde::{Deserialize, Serialize};
 use crate::HarnessError;
 use crate::method::Method;
 
-use crate::standard_alc::StandardWeights;
 use palc_user::{Family, SimulatedUser, Spread, Style, StylePreset};
 
 /// Everything that describes one run of the lesson-learning loop.
@@ -244,7 +246,7 @@ pub struct StoppingConfig {
     pub max_lane_changes: usize,
     /// Users with spread: lane changes driven after the run has ended, with
     /// learning frozen, each judged by the drawn user against the nominal plan on
-    /// the same draw ([`crate::FrozenEvaluation`]); `0` for none. Default `50`.
+    /// the same draw ([`crate::record::FrozenEvaluation`]); `0` for none. Default `50`.
     pub frozen_lane_changes: usize,
 }
 
