@@ -226,3 +226,111 @@ fn record_onset(experience: &mut Experience, setup: &Setup, start_s: f64) {
     experience.anchor_s = Some(merged.time_s);
     onsets.push(merged);
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use palc_user::quintic;
+
+    const DT: f64 = 0.1;
+    const TARGET_L: f64 = 3.5;
+
+    /// A quintic lane change from `start_s` over `duration_s`, at steps `0..=k`.
+    fn lane_change(start_s: f64, duration_s: f64, k: usize) -> Vec<f64> {
+        (0..=k)
+            .map(|i| {
+                let t = (i as f64 * DT - start_s) / duration_s;
+                TARGET_L * quintic(t.clamp(0.0, 1.0))
+            })
+            .collect()
+    }
+
+    fn paths<'a>(driven: &'a [f64], planned: &'a [f64], takeover_step: usize) -> LessonPaths<'a> {
+        LessonPaths {
+            driven_l: driven,
+            planned_l: planned,
+            takeover_step,
+            dt: DT,
+            target_l: TARGET_L,
+        }
+    }
+
+    #[test]
+    fn replay_demonstrates_what_was_driven_and_sees_the_start() {
+        let driven = lane_change(3.0, 2.0, 80);
+        let planned = lane_change(5.0, 3.0, 80);
+        let demonstration = Replay.demonstrate(&paths(&driven, &planned, 32));
+        assert_eq!(demonstration.path, None);
+        let start = demonstration.start_s.expect("a lane change to fit");
+        assert!((start - 3.0).abs() < 0.15, "{start}");
+    }
+
+    #[test]
+    fn relative_onset_demonstrates_the_whole_fitted_lane_change() {
+        // The system drove its own plan until step 35, then the user drove its quintic.
+        let user = lane_change(3.0, 2.0, 80);
+        let planned = lane_change(5.0, 3.0, 80);
+        let takeover = 35;
+        let driven: Vec<f64> = (0..=80)
+            .map(|i| if i < takeover { planned[i] } else { user[i] })
+            .collect();
+        let demonstration = RelativeOnset.demonstrate(&paths(&driven, &planned, takeover));
+        let path = demonstration.path.expect("a fitted path");
+        assert_eq!(path.len(), driven.len());
+        // After the takeover it is what the user drove; before, close to the user's own.
+        assert_eq!(path[takeover..], driven[takeover..]);
+        let worst = (path.iter().zip(&user))
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 0.1, "{worst}");
+    }
+
+    #[test]
+    fn nothing_to_fit_is_no_demonstration_and_no_start() {
+        let flat = vec![0.0; 41];
+        for personalization in [
+            &mut Replay as &mut dyn Personalization,
+            &mut RelativeOnset,
+            &mut SceneAveraged::new(RelativeOnset),
+        ] {
+            let demonstration = personalization.demonstrate(&paths(&flat, &flat, 10));
+            assert_eq!(
+                demonstration,
+                Demonstration::default(),
+                "{personalization:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn scene_averaging_follows_the_gap_the_accepted_lane_changes_point_to() {
+        let planned = lane_change(6.0, 3.0, 120);
+        let mut averaged = SceneAveraged::new(Replay);
+        // Three lane changes the user accepted start at 3 s.
+        for _ in 0..3 {
+            averaged.accepted(&lane_change(3.0, 2.0, 120), DT, TARGET_L);
+        }
+        // A lesson into another gap (8 s) keeps the plan and shows no start.
+        let late = lane_change(8.0, 2.0, 120);
+        let demonstration = averaged.demonstrate(&paths(&late, &planned, 70));
+        assert_eq!(demonstration.path.as_deref(), Some(&planned[..]));
+        assert_eq!(demonstration.start_s, None);
+        // A lesson into the 3 s gap is followed, with its start.
+        let early = lane_change(3.0, 2.0, 120);
+        let demonstration = averaged.demonstrate(&paths(&early, &planned, 20));
+        let path = demonstration.path.expect("the mean of the gap's lessons");
+        assert!((path.iter().zip(&early)).all(|(a, b)| (a - b).abs() < 1e-12));
+        assert!(demonstration.start_s.is_some());
+    }
+
+    #[test]
+    fn the_methods_options_compose_their_implementations() {
+        let paper = format!("{:?}", for_options(&AggregatorOptions::paper()));
+        assert_eq!(paper, "Replay");
+        let palc = format!("{:?}", for_options(&AggregatorOptions::default()));
+        assert!(
+            palc.starts_with("SceneAveraged { inner: RelativeOnset"),
+            "{palc}"
+        );
+    }
+}

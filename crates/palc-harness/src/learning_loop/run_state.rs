@@ -290,4 +290,22 @@ mod tests {
         assert_eq!(termination(&s, &records[..6], p), None);
         assert_eq!(termination(&s, &records[..7], p), Some(Outcome::CapReached));
     }
+
+    #[test]
+    fn counting_lane_changes_keeps_the_takeovers_and_the_streak() {
+        let mut run = RunState {
+            last_lesson_failed: true,
+            ..RunState::default()
+        };
+        for record in deterministic("T--T-") {
+            run.count(record);
+        }
+        assert_eq!((run.takeovers, run.streak, run.records.len()), (2, 1, 5));
+        // A new lane change clears the last lesson's failure until its own lesson.
+        assert!(!run.last_lesson_failed);
+        assert_eq!(
+            termination(&stopping(), &run.records, progress("T--T-")),
+            super::termination(&stopping(), &run)
+        );
+    }
 }
