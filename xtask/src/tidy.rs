@@ -192,7 +192,18 @@ const DEPENDENCY_RULES: &[(&str, &[&str], bool)] = &[
         &["palc-zone-filter", "palc-planner"],
         true,
     ),
-    ("palc-user", &["palc-traffic", "palc-planner"], false),
+    ("palc-user", &["palc-planner"], true),
+    (
+        "palc-harness",
+        &[
+            "palc-traffic",
+            "palc-zone-filter",
+            "palc-planner",
+            "palc-aggregator",
+            "palc-user",
+        ],
+        true,
+    ),
 ];
 
 #[test]
@@ -253,6 +264,9 @@ fn outputs_are_written_only_through_the_output_module() {
         "fs::write(",
         "Writer::from_path(",
         "OpenOptions::new(",
+        "SVGBackend::new(",
+        "BitMapBackend::new(",
+        "BitMapBackend::gif(",
     ];
     let offenders: Vec<String> = files
         .iter()

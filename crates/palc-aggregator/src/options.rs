@@ -59,8 +59,8 @@ pub struct AggregatorOptions {
     pub follow_user_speed: bool,
 }
 
-/// How learned weights carry into another scene (docs/paper-mapping.md,
-/// "Experience in relative space").
+/// How learned weights carry into another scene
+/// (docs/experiments/0042-observing-the-users-start.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Representation {

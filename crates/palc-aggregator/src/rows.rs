@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 /// stiffness `w1`, which is exactly what the start of a lane change needs. An
 /// independent prototype personalized 60 / 60 grid cases with these two rows and
 /// counter-steered in 7 / 60 when the heading and cross terms were learned too
-/// (docs/paper-mapping.md, "Learnable rows").
+/// (docs/experiments/0010-learnable-rows-and-feature-scale.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(try_from = "Vec<String>", into = "Vec<String>")]
 pub struct LearnableRows([bool; FEATURE_COUNT]);

@@ -95,10 +95,11 @@ proptest! {
     // A fixed seed keeps CI reproducible. With the maximum-likelihood zone (ridge 0),
     // other seeds can draw a zone-centre expert whose plan the Riccati backend stops
     // at `MaxIterations` (e.g. K = 24, takeover at 0.354 K, pulls 0.263 and 0.05, the
-    // paper's options, no learnable rows); that case is recorded in
-    // docs/paper-mapping.md, "Planner: the Riccati interior point". Since the fixes of
+    // paper's options, no learnable rows); such a case is recorded in
+    // docs/experiments/0027-agreement-with-clarabel.md. Since the fixes of
     // `the_large_budget_zone_centre_case_solves`, seeds 11 and 20261202 passed 20,000
-    // cases each; the seed stays fixed for CI.
+    // cases each (docs/experiments/0035-breakdowns-and-cycles.md); the seed stays
+    // fixed for CI.
     #![proptest_config(ProptestConfig {
         rng_seed: proptest::test_runner::RngSeed::Fixed(20261201),
         ..ProptestConfig::with_cases(32)

@@ -1,5 +1,5 @@
 //! REPORT.md's user-family section: every user kind of `[[users]]` on the grid,
-//! both methods, one row each (docs/paper-mapping.md, "User families").
+//! both methods, one row each (docs/experiments/0036-user-families.md).
 
 use std::fmt::Write as _;
 
@@ -67,7 +67,7 @@ pub fn section(out: &mut String, all: &[RunRow], methods: &[Method], kinds: &[Us
         out,
         "Every user kind of the config's `[[users]]`, each run on every grid cell and style. A family \
          refines each of the paper's styles (start rule, reaction, lateral profile, speed, \
-         perceived-safety takeover; docs/paper-mapping.md, \"User families\"). Both methods run with \
+         perceived-safety takeover; docs/experiments/0036-user-families.md). Both methods run with \
          one set of settings for every kind: nothing in `palc` is tuned per family. A kind counts as \
          learned when at least {:.0} % of its counted runs personalize; refused runs (a user without \
          a sane lane change in the scene, named in the refusals section) are not counted. For users \

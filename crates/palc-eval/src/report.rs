@@ -52,7 +52,8 @@ pub fn render(input: &ReportInput) -> String {
         "The numbers below come from palc's simulation and user model; the paper's come from its MATLAB \
          test bed. No parameter was tuned to match the paper. A run that does not personalize within the \
          cap counts as a failure, at the cap, in every statistic. `paper` is the printed method with only \
-         its equation errors corrected; `palc` is palc's repaired method (docs/paper-mapping.md).\n"
+         its equation errors corrected; `palc` is palc's repaired method \
+         (docs/experiments/0005-the-two-methods.md).\n"
     );
     if m.quick {
         let _ = writeln!(
@@ -115,13 +116,21 @@ fn summary_section(out: &mut String, input: &ReportInput) {
             let summary = Summary::of(grid(rows, method, user));
             let transfer = crate::stats::transfer(&with_transfer(rows, method, user));
             let experience = match (transfer.without, transfer.with, transfer.reduction) {
-                (Some(without), Some(with), Some(reduction)) => format!(
-                    "{} -> {} ({:.0} % fewer, {} cells)",
-                    num(Some(without), 1),
-                    num(Some(with), 1),
-                    reduction * 100.0,
-                    transfer.pairs
-                ),
+                (Some(without), Some(with), Some(reduction)) => {
+                    // `+ 0.0` turns a rounded -0 into 0.
+                    let percent = (reduction * 100.0).round() + 0.0;
+                    let change = if percent >= 0.0 {
+                        format!("{percent} % fewer")
+                    } else {
+                        format!("{} % more", -percent)
+                    };
+                    format!(
+                        "{} -> {} ({change}, {} cells)",
+                        num(Some(without), 1),
+                        num(Some(with), 1),
+                        transfer.pairs
+                    )
+                }
                 _ => "n/a".to_owned(),
             };
             let _ = writeln!(
@@ -247,7 +256,8 @@ fn user_section(out: &mut String, input: &ReportInput, user: &str) {
         let _ = writeln!(
             out,
             "Where a method rarely personalizes ({}), its mean is close to the cap and says more \
-             about the cap than about the method; docs/paper-mapping.md names the mechanisms \
+             about the cap than about the method; docs/experiments/0005-the-two-methods.md \
+             names the mechanisms \
              (labels, expert, correction rule) and the measurements behind palc's repairs.\n",
             rarely.join(", ")
         );
@@ -420,9 +430,9 @@ fn refusals(out: &mut String, rows: &[RunRow]) {
     failed_runs(out, &failed);
 }
 
-/// Runs that stopped on an error, counted by the error's kind (its first two
-/// clauses) and experiment, each kind with one example; every one is in
-/// `runs.csv` with its message.
+/// Runs that stopped on an error, counted by the error's kind (its first
+/// clause, e.g. `problem is infeasible`) and experiment, each kind with one
+/// example; every one is in `runs.csv` with its message.
 fn failed_runs(out: &mut String, failed: &[&RunRow]) {
     if failed.is_empty() {
         return;
@@ -437,13 +447,13 @@ fn failed_runs(out: &mut String, failed: &[&RunRow]) {
         if !experiments.contains(&experiment) {
             experiments.push(experiment);
         }
-        let kind = cause_kind(error);
+        let kind = failure_kind(error);
         if !kinds.iter().any(|(k, _)| *k == kind) {
             kinds.push((kind, format!("`{}`: {error}", row.spec.label())));
         }
     }
     let kind_of = |row: &RunRow| match &row.status {
-        Status::Failed { error } => Some(cause_kind(error).to_owned()),
+        Status::Failed { error } => Some(failure_kind(error).to_owned()),
         _ => None,
     };
     let _ = writeln!(
@@ -540,6 +550,12 @@ fn learning_failures(out: &mut String, input: &ReportInput) {
         );
     }
     let _ = writeln!(out);
+}
+
+/// The kind of a run's error: its first clause (`what failed`), without the
+/// details after the first colon.
+fn failure_kind(error: &str) -> &str {
+    error.split_once(": ").map_or(error, |(kind, _)| kind)
 }
 
 /// The kind of a learning error: its first two clauses (`what failed: why`),

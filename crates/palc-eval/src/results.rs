@@ -405,6 +405,46 @@ mod tests {
     }
 
     #[test]
+    fn refusals_csv_lists_every_refused_run_with_its_kind_and_json_keeps_the_fields() {
+        let rows = synthetic_rows();
+        let refused: Vec<&RunRow> = rows.iter().filter(|r| !r.status.counted()).collect();
+        assert!(!refused.is_empty());
+        let dir = std::env::temp_dir().join(format!("palc-eval-refusals-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("refusals.csv");
+        write_refusals(&rows, &path).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let mut lines = text.lines();
+        assert_eq!(
+            lines.next(),
+            Some("id,experiment,method,user,style,speed_case,headway_m,seed,kind,reason")
+        );
+        assert_eq!(lines.count(), refused.len());
+        for row in &refused {
+            let kind = row.status.refusal_kind().unwrap();
+            assert!(text.contains(&format!(",{kind},")), "{kind} in {text}");
+        }
+        // The harness's refusal keeps its fields in runs.json and reads back typed.
+        let typed = (refused.iter())
+            .find(|r| {
+                matches!(
+                    r.status,
+                    Status::Refused {
+                        refusal: Some(_),
+                        ..
+                    }
+                )
+            })
+            .expect("a refusal of the harness");
+        let json = serde_json::to_value(&typed.status).unwrap();
+        assert_eq!(json["kind"], "refused");
+        assert!(json["refusal"]["kind"].is_string(), "{json}");
+        let back: Status = serde_json::from_value(json).unwrap();
+        assert_eq!(&back, &typed.status);
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
     fn times_read_back_as_named_parts_and_as_an_old_array() {
         let iteration = synthetic_rows().remove(0).iterations.remove(0);
         let json = serde_json::to_value(&iteration).unwrap();

@@ -1,6 +1,9 @@
 //! REPORT.md's safety section: collisions, RSS safe-distance violations, the
 //! safety layer's refusals and the distributions of the smallest gaps and times to
-//! collision, per experiment and method (docs/paper-mapping.md, "Safety").
+//! collision, per experiment and method
+//! (docs/experiments/0030-safety-measures-acc-and-gap-seeking.md,
+//! docs/experiments/0031-the-safety-layer-and-the-papers-scenes.md and
+//! docs/experiments/0032-the-safe-set-up-measured.md).
 
 use std::fmt::Write as _;
 
@@ -26,13 +29,13 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
          Whatever drives the ego (plan, re-plan or user), the longitudinal guard \
          (`planning.acc.guard`, on by default) caps its acceleration by the ACC's law behind \
          the vehicle ahead in a lane it moves into and by the ACC's emergency brake in its \
-         own lane; the lateral path stays the driver's (docs/paper-mapping.md, \"The \
-         longitudinal guard\"). The paper's set-up otherwise holds every speed constant and \
+         own lane; the lateral path stays the driver's \
+         (docs/experiments/0034-the-longitudinal-guard.md). The paper's set-up otherwise \
+         holds every speed constant and \
          has no safety layer: under the layer alone none of its scenes has a safe lane change \
          (the ego closes on the preceding vehicle, or on the target lane's platoon, below the \
          safe distance) and every cell is refused, so its figures are measured on scenes the \
-         layer would refuse (docs/paper-mapping.md, \"The paper's scenes under the safety \
-         layer\"); \
+         layer would refuse (docs/experiments/0031-the-safety-layer-and-the-papers-scenes.md); \
          `configs/reproduce-safe.toml` is the same evaluation with the ego's ACC, the safety layer \
          and users who start only into gaps at the safe distance (`cargo xtask reproduce-paper` \
          writes its report to `safe/REPORT.md`, and the stress scenes of `configs/stress/` under \

@@ -1,7 +1,8 @@
-//! REPORT.md's transfer-matrix and accumulation section (docs/paper-mapping.md,
-//! "Experience in relative space"): what experience from every other speed case
-//! (and headway) does to each cell, and what a user who drives the scenes in
-//! sequence lives through.
+//! REPORT.md's transfer-matrix and accumulation section
+//! (docs/experiments/0017-how-the-reproduction-counts.md; measured in
+//! docs/experiments/0047-relative-onset-measured.md): what experience from every
+//! other speed case (and headway) does to each cell, and what a user who drives the
+//! scenes in sequence lives through.
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -17,8 +18,8 @@ fn mean(values: &[f64]) -> Option<f64> {
     (!values.is_empty()).then(|| values.iter().sum::<f64>() / values.len() as f64)
 }
 
-/// palc's targets for experience across scenes (docs/paper-mapping.md,
-/// "Reproduction: how `cargo xtask reproduce-paper` counts"): the reduction of the
+/// palc's targets for experience across scenes
+/// (docs/experiments/0017-how-the-reproduction-counts.md): the reduction of the
 /// mean takeovers with experience from another speed case (twice the paper's 24 %)
 /// and from another headway, with no pair more than one takeover worse than from
 /// scratch and none at the cap.

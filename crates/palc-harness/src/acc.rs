@@ -3,7 +3,7 @@
 //!
 //! The paper holds every speed constant per speed case. palc does not: an ego that
 //! keeps its speed while a user waits for a gap on the target lane drives through
-//! the slower vehicle ahead (docs/paper-mapping.md, "Ego longitudinal behaviour").
+//! the slower vehicle ahead (docs/experiments/0030-safety-measures-acc-and-gap-seeking.md).
 //! Whenever the system is not executing a lane-change plan (the approach, the
 //! lane-keeping prediction that users' start rules see, the user's own driving after
 //! a takeover) the ego follows the nearest vehicle ahead in the lanes its body
@@ -41,7 +41,7 @@ pub struct AccConfig {
     /// as in the paper (the evaluation's scenes and figures). On, an ego behind a
     /// vehicle as slow as the target lane slows to its speed and drops back to seek
     /// a gap, and the users' headway start rules no longer describe that situation
-    /// (docs/paper-mapping.md, "Ego longitudinal behaviour", an open problem).
+    /// (docs/experiments/0030-safety-measures-acc-and-gap-seeking.md, an open problem).
     pub enabled: bool,
     /// Time gap `T` kept to the vehicle ahead (s). 0.8 s is the shortest that
     /// ISO 15622 lets an ACC offer; it must be shorter than every user's start

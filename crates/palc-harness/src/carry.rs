@@ -1,6 +1,7 @@
-//! Carrying an experience into a new scene (docs/paper-mapping.md, "Experience in
-//! relative space"): the weights anchored at the user's start predicted in relative
-//! space, and a rehearsal of the user's path in the new scene's dynamics.
+//! Carrying an experience into a new scene
+//! (docs/experiments/0046-carrying-rehearsal-and-bounds.md): the weights anchored
+//! at the user's start predicted in relative space, and a rehearsal of the user's
+//! path in the new scene's dynamics.
 
 use palc_aggregator::{
     AggregatorError, AggregatorOptions, Experience, Lesson, StepOutcome, learn_from_lesson,

@@ -4,10 +4,11 @@
 //!
 //! The paper holds every speed constant per speed case, and so does a plan made at
 //! those speeds: an ego that moves over behind a slower target-lane vehicle keeps
-//! closing on it until the horizon ends (docs/paper-mapping.md, "The longitudinal
-//! guard"). A production lane-change assistant runs on top of the ACC, which keeps
-//! braking for the vehicle ahead while the lateral controller changes lanes. The
-//! guard is that ACC underneath: at each step the ego's acceleration is
+//! closing on it until the horizon ends
+//! (docs/experiments/0034-the-longitudinal-guard.md). A production lane-change
+//! assistant runs on top of the ACC, which keeps braking for the vehicle ahead
+//! while the lateral controller changes lanes. The guard is that ACC underneath: at
+//! each step the ego's acceleration is
 //!
 //! ```text
 //! a = min( a_drive,  a_limit )
@@ -44,8 +45,8 @@ impl AccConfig {
     /// layer every plan is checked safe before it is driven, and braking at RSS's
     /// `b_min` a second of closing speed before the safe distance (as the ACC does
     /// when it drives) made plans the layer had let through close the gap to the
-    /// target lane's lag, and the layer then refused them (docs/paper-mapping.md,
-    /// "The longitudinal guard").
+    /// target lane's lag, and the layer then refused them
+    /// (docs/experiments/0034-the-longitudinal-guard.md).
     pub(crate) fn guard_following(&self, v: f64, (gap, leader_v): (f64, f64)) -> Option<f64> {
         if !self.guard {
             return None;

@@ -5,9 +5,10 @@
 //!   (y = 0); shared-covariance GDA on the six features of Eq. (1); the projection
 //!   of Eqs. (27)-(32); hard lateral bounds; the zone-centre expert (Eqs. 24-26);
 //!   Abbeel & Ng's projection method on all ten weight rows (Eqs. 33-36).
-//! - `palc`: the design palc defends by measurement (docs/paper-mapping.md):
-//!   the lesson expert (the executed trajectory re-planned through the QP), the
-//!   incremental correction of the lateral rows w1 and w2 only, and no zone by
+//! - `palc`: the design palc defends by measurement
+//!   (docs/experiments/0005-the-two-methods.md): the lesson expert (the executed
+//!   trajectory re-planned through the QP), the target rule (iterative learning of
+//!   each stage's lateral target) on the lateral rows w1 and w2 only, and no zone by
 //!   default, because in measurement a zone on top made convergence worse.
 
 use palc_aggregator::AggregatorOptions;

@@ -1,7 +1,7 @@
-//! How a method personalizes (paper Section II.C; docs/paper-mapping.md, "The two
-//! methods"): what a lesson demonstrates, what an accepted lane change tells, and
-//! how experience is carried into a new scene. The loop asks a [`Personalization`]
-//! and switches on no flag of its own.
+//! How a method personalizes (paper Section II.C;
+//! docs/experiments/0005-the-two-methods.md): what a lesson demonstrates, what an
+//! accepted lane change tells, and how experience is carried into a new scene. The
+//! loop asks a [`Personalization`] and switches on no flag of its own.
 //!
 //! Three implementations compose every method and ablation rung
 //! ([`for_options`]):
@@ -12,6 +12,7 @@
 //! | [`RelativeOnset`] (palc's) | the user's whole lane change, fitted before the takeover | anchored at the user's start predicted in relative space |
 //! | [`SceneAveraged`] around either | the mean of the scene's lessons in the gap its lane changes point to | as the inner one |
 
+use std::cell::OnceCell;
 use std::fmt;
 
 use palc_aggregator::{AggregatorOptions, Experience, Representation};
@@ -23,8 +24,9 @@ use crate::onset::{UserLaneChange, onset_at};
 use crate::scene_lessons::SceneLessons;
 use crate::setup::Setup;
 
-/// The lateral paths of one taken-over lane change, at steps `0..=K` of `dt`.
-#[derive(Debug, Clone, Copy)]
+/// The lateral paths of one taken-over lane change, at steps `0..=K` of `dt`,
+/// with the user's lane change fitted to them once, when first asked for.
+#[derive(Debug, Clone)]
 pub struct LessonPaths<'a> {
     /// What was driven: the system up to the takeover, then the user.
     pub driven_l: &'a [f64],
@@ -36,6 +38,36 @@ pub struct LessonPaths<'a> {
     pub dt: f64,
     /// The target lane's centre (m).
     pub target_l: f64,
+    /// The user's lane change fitted to what it drove after the takeover.
+    fitted: OnceCell<Option<UserLaneChange>>,
+}
+
+impl<'a> LessonPaths<'a> {
+    /// The paths of a lesson taken over at `takeover_step`.
+    pub fn new(
+        driven_l: &'a [f64],
+        planned_l: &'a [f64],
+        takeover_step: usize,
+        dt: f64,
+        target_l: f64,
+    ) -> Self {
+        LessonPaths {
+            driven_l,
+            planned_l,
+            takeover_step,
+            dt,
+            target_l,
+            fitted: OnceCell::new(),
+        }
+    }
+
+    /// The user's own lane change fitted to what it drove after the takeover
+    /// (`onset::UserLaneChange::fit`); `None` when too little is left to fit.
+    fn fitted(&self) -> Option<UserLaneChange> {
+        *self.fitted.get_or_init(|| {
+            UserLaneChange::fit(self.driven_l, self.takeover_step, self.dt, self.target_l)
+        })
+    }
 }
 
 /// What a lesson teaches.
@@ -103,21 +135,23 @@ impl Personalization for Replay {
     fn demonstrate(&mut self, lesson: &LessonPaths<'_>) -> Demonstration {
         Demonstration {
             path: None,
-            start_s: fit(lesson).map(|user| user.start_s),
+            start_s: lesson.fitted().map(|user| user.start_s),
         }
     }
 }
 
-/// palc's personalization in relative space (docs/paper-mapping.md, "Experience
-/// in relative space"): the expert follows the user's whole lane change (before
-/// the takeover, the model fitted to what the user drove after it), and the
-/// weights carry anchored at the start predicted in the new scene.
+/// palc's personalization in relative space
+/// (docs/experiments/0046-carrying-rehearsal-and-bounds.md; measured in
+/// docs/experiments/0047-relative-onset-measured.md): the expert follows the
+/// user's whole lane change (before the takeover, the model fitted to what the
+/// user drove after it), and the weights carry anchored at the start predicted in
+/// the new scene.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct RelativeOnset;
 
 impl Personalization for RelativeOnset {
     fn demonstrate(&mut self, lesson: &LessonPaths<'_>) -> Demonstration {
-        match fit(lesson) {
+        match lesson.fitted() {
             Some(user) => Demonstration {
                 path: Some(user.path(lesson.driven_l, lesson.takeover_step, lesson.dt)),
                 start_s: Some(user.start_s),
@@ -137,10 +171,12 @@ impl Personalization for RelativeOnset {
     }
 }
 
-/// The mean of the scene's lessons (`average_lessons`; docs/paper-mapping.md,
-/// "Users with spread"): the expert of a lesson follows the mean of the inner
-/// demonstrations that started in the gap the scene's lane changes point to; a
-/// lesson into another gap keeps the plan and shows no start.
+/// The mean of the scene's lessons (`average_lessons`;
+/// docs/experiments/0050-users-with-spread-averaging-and-window.md,
+/// docs/experiments/0063-the-gap-the-lane-changes-point-to.md): the expert of a
+/// lesson follows the mean of the inner demonstrations that started in the gap the
+/// scene's lane changes point to; a lesson into another gap keeps the plan and
+/// shows no start.
 #[derive(Debug, Clone, Default)]
 pub struct SceneAveraged<P> {
     inner: P,
@@ -160,7 +196,7 @@ impl<P> SceneAveraged<P> {
 impl<P: Personalization> Personalization for SceneAveraged<P> {
     fn demonstrate(&mut self, lesson: &LessonPaths<'_>) -> Demonstration {
         let inner = self.inner.demonstrate(lesson);
-        let Some(user) = fit(lesson) else {
+        let Some(user) = lesson.fitted() else {
             return inner;
         };
         let path = (inner.path).unwrap_or_else(|| lesson.driven_l.to_vec());
@@ -192,16 +228,6 @@ impl<P: Personalization> Personalization for SceneAveraged<P> {
     fn observe_start(&self, experience: &mut Experience, setup: &Setup, start_s: f64) {
         self.inner.observe_start(experience, setup, start_s);
     }
-}
-
-/// The user's own lane change fitted to what it drove after the takeover.
-fn fit(lesson: &LessonPaths<'_>) -> Option<UserLaneChange> {
-    UserLaneChange::fit(
-        lesson.driven_l,
-        lesson.takeover_step,
-        lesson.dt,
-        lesson.target_l,
-    )
 }
 
 /// Merges the start `start_s` seen in `setup` into this scene's onset (the last
@@ -246,13 +272,7 @@ mod tests {
     }
 
     fn paths<'a>(driven: &'a [f64], planned: &'a [f64], takeover_step: usize) -> LessonPaths<'a> {
-        LessonPaths {
-            driven_l: driven,
-            planned_l: planned,
-            takeover_step,
-            dt: DT,
-            target_l: TARGET_L,
-        }
+        LessonPaths::new(driven, planned, takeover_step, DT, TARGET_L)
     }
 
     #[test]

@@ -34,16 +34,16 @@ pub struct SafetyConfig {
     /// ALC's instead), makes the standard ALC wait for safe target-lane gaps and
     /// refuses scenes without a safe lane change. Off by default: in the paper's
     /// scenes, where the ego closes on the preceding vehicle at constant speed, no
-    /// lane change keeps the RSS distance to it (docs/paper-mapping.md, "Safety").
-    /// The measures are taken either way.
+    /// lane change keeps the RSS distance to it
+    /// (docs/experiments/0031-the-safety-layer-and-the-papers-scenes.md). The
+    /// measures are taken either way.
     pub enforce: bool,
     /// Whether the simulated users of this configuration start their lane change
     /// only when both target-lane gaps stay at least the safe distance below at
     /// every step of the lane change started there (on the ego's lane-keeping
     /// motion), besides their style's own gap acceptance: users whose preferred
     /// lane change is safe. Off by default: the paper's users accept any positive
-    /// gap behind them (docs/paper-mapping.md, "Ego longitudinal behaviour and
-    /// safety").
+    /// gap behind them (docs/experiments/0038-users-who-wait-for-safe-gaps.md).
     pub users_wait_for_safe_gaps: bool,
     /// Response time `ρ` of the rear vehicle (s).
     pub response_time_s: f64,
@@ -58,7 +58,8 @@ pub struct SafetyConfig {
 impl Default for SafetyConfig {
     /// ρ = 0.5 s, the response time of an automated system (a human's is 1-1.5 s);
     /// a_acc = 1.5 m/s², the ego ACC's own limit; and `b_min = b_max` = 6 m/s²:
-    /// vehicles of one class that brake alike (docs/paper-mapping.md, "Safety").
+    /// vehicles of one class that brake alike
+    /// (docs/experiments/0030-safety-measures-acc-and-gap-seeking.md).
     fn default() -> Self {
         Self {
             enforce: false,

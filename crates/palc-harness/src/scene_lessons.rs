@@ -1,5 +1,7 @@
-//! Averaging the lessons of a scene (`[aggregator] average_lessons`,
-//! docs/paper-mapping.md, "Users with spread").
+//! Averaging the lessons of a scene (`[aggregator] average_lessons`;
+//! docs/experiments/0050-users-with-spread-averaging-and-window.md,
+//! docs/experiments/0051-one-gap-at-a-time.md and
+//! docs/experiments/0063-the-gap-the-lane-changes-point-to.md).
 //!
 //! A user with spread drives each lane change a little differently; a learner
 //! that follows each lesson's path chases the last draw and oscillates around the

@@ -129,7 +129,7 @@ proptest::proptest! {
     /// In any scene of the test bed that the set-up accepts (the paper's constant
     /// speeds, no safety layer), no lane change of a `palc` run collides, in the
     /// steps the system drove or the user did. Without the guard, 947 of the grid's
-    /// 8,014 did (docs/paper-mapping.md, "The longitudinal guard").
+    /// 8,014 did (docs/experiments/0034-the-longitudinal-guard.md).
     #[test]
     fn no_lane_change_of_the_test_bed_collides_under_the_guard(
         case in 0usize..4,

@@ -1,6 +1,8 @@
 //! Experience in relative space: the user's start is observed in a lesson, and a
 //! carried experience is anchored where a new scene predicts it
-//! (docs/paper-mapping.md, "Experience in relative space").
+//! (docs/experiments/0042-observing-the-users-start.md,
+//! docs/experiments/0043-predicting-the-start.md; measured in
+//! docs/experiments/0047-relative-onset-measured.md).
 
 use palc_aggregator::{AggregatorOptions, Representation};
 use palc_harness::{

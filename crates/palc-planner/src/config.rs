@@ -32,7 +32,7 @@ pub enum LateralBoundsMode {
 
 /// The QP backend. Both solve the same assembled QP and return the same [`Plan`](crate::Plan)
 /// and [`PlanError`](crate::PlanError)s (one exception: the Riccati backend does not look
-/// for a certificate of unboundedness, see docs/paper-mapping.md).
+/// for a certificate of unboundedness, see docs/experiments/0026-riccati-interior-point.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
@@ -44,7 +44,7 @@ pub enum Backend {
     /// `max_iter` of [`SolverSettings`]; the other settings are clarabel's. The default:
     /// it agrees with clarabel in the property tests and, on the benchmark lane change
     /// at K = 120, plans about 5-6 times faster (`benches/plan.rs`,
-    /// `examples/plan_latency.rs`; figures in docs/paper-mapping.md).
+    /// `examples/plan_latency.rs`; figures in docs/experiments/0028-planner-speed.md).
     #[default]
     Riccati,
     /// The general sparse interior-point solver of the `clarabel` crate, kept as the
@@ -55,7 +55,8 @@ pub enum Backend {
 }
 
 /// Settings passed to the QP solver; the defaults were chosen by measurement
-/// (see the crate documentation and docs/paper-mapping.md). Both backends read
+/// (see the crate documentation and
+/// docs/experiments/0021-qp-form-and-solver-settings.md). Both backends read
 /// `max_iter` and the three tolerances; the last three fields are clarabel's.
 ///
 /// [`PlannerConfig::validate`] holds every number to a documented range:
@@ -127,7 +128,7 @@ pub struct PlannerConfig {
     /// ([`Problem::reference_acceleration`](crate::Problem::reference_acceleration); 0 at
     /// constant speed). The printed cost leaves the acceleration free, which makes the
     /// optimum non-unique and, with `w9` or `w10` non-zero, absurd; see
-    /// docs/paper-mapping.md.
+    /// docs/experiments/0019-planner-model-cost-and-reference-acceleration.md.
     pub acceleration_penalty: f64,
     /// Lowest front wheel angle `δ_min` (rad) of Eq. (23).
     pub steering_min: f64,

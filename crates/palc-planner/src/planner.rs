@@ -14,7 +14,8 @@ use crate::{
     StepRanges, features,
 };
 
-/// The extra cost terms added to `w · Φ` (documented in docs/paper-mapping.md).
+/// The extra cost terms added to `w · Φ` (documented in
+/// docs/experiments/0019-planner-model-cost-and-reference-acceleration.md).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Extras {

@@ -18,7 +18,8 @@ pub struct Lane(pub u32);
 /// A straight multi-lane road section.
 ///
 /// `s` is unbounded: vehicles keep driving past `length`, which only bounds where a
-/// scenario may place vehicles at its start (see docs/paper-mapping.md, "Test bed geometry").
+/// scenario may place vehicles at its start (see
+/// docs/experiments/0015-test-bed-geometry-and-platoon.md).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Road {
     /// Length of the section in which vehicles are placed at the start (m).

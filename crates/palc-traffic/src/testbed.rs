@@ -2,7 +2,7 @@
 //! a platoon at the background speed on the target lane 1, and the grid of speed cases,
 //! adjacent headways and seeds.
 //!
-//! Placement (docs/paper-mapping.md, "Test bed geometry" and "Headway definition"):
+//! Placement (docs/experiments/0015-test-bed-geometry-and-platoon.md):
 //! - the ego (id 0) starts on lane 0 at `ego_start_s_m` with the case's ego speed;
 //! - the preceding vehicle (id 1) starts `initial_time_headway_s` times the ego speed ahead,
 //!   front to front, at the background speed, with IDM v0 equal to the background speed;

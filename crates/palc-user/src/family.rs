@@ -4,8 +4,8 @@
 //!
 //! A [`Family`] refines a [`Style`](crate::Style) (the paper's headway,
 //! duration and gap acceptance): its defaults are the paper's user, so an empty
-//! `[user.family]` table changes nothing. docs/paper-mapping.md ("User
-//! families") says why each rule is plausible for a human driver.
+//! `[user.family]` table changes nothing. docs/experiments/0036-user-families.md
+//! says why each rule is plausible for a human driver.
 
 use serde::{Deserialize, Serialize};
 

@@ -132,7 +132,7 @@ impl SimulatedUser {
         // step alone put the user 18.6 m behind the target lane's leader, below the
         // 19.9 m RSS distance, at step 69 (collector-high / 35 m / seed 1, cautious),
         // and the safety layer refused the plans that copied it
-        // (docs/paper-mapping.md, "Users who wait for safe gaps").
+        // (docs/experiments/0038-users-who-wait-for-safe-gaps.md).
         // A user with a speed of its own (speed matching) checks the gaps on its
         // own motion from the start on as well: checked on the lane keeping's alone,
         // a speed-matching user slowing towards the target lane's speed fell 7.1 m

@@ -16,7 +16,7 @@ pub struct Style {
     pub lane_change_duration_s: f64,
     /// Smallest net gap to the leader on the target lane that the user accepts,
     /// as a time gap at the ego's speed (s). Not in the paper: it makes the
-    /// paper's congestion levels matter (see docs/paper-mapping.md).
+    /// paper's congestion levels matter (see docs/experiments/0002-the-papers-user-model.md).
     #[serde(default = "Style::default_min_lead_gap_s")]
     pub min_lead_gap_s: f64,
     /// Smallest net gap to the follower on the target lane that the user accepts,

@@ -26,7 +26,7 @@ use crate::{AggregatorError, feature_error, project_convex};
 /// Unlike the feature-matching steps of [`crate::IncrementalRule`], whose plans
 /// stay 0.25–0.30 m from the user after personalization on the paper's grid, the
 /// plan converges to the expert's lateral path; it ends 0.08–0.12 m from the user
-/// in the default scenario (docs/paper-mapping.md, "Aggregator: reward correction").
+/// in the default scenario (docs/experiments/0009-reward-correction.md).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct TargetRule {

@@ -240,7 +240,7 @@ pub struct StoppingConfig {
     /// Default `0.05`: one takeover more than the nominal plan in 20 lane changes.
     /// (A window of 10 within 0.1 stopped runs whose plan, frozen, was then taken
     /// over 5 times more than the nominal plan in 50 lane changes:
-    /// docs/paper-mapping.md, "Users with spread".)
+    /// docs/experiments/0050-users-with-spread-averaging-and-window.md.)
     pub spread_margin: f64,
     /// Users with spread: lane changes after which the run stops in any case.
     pub max_lane_changes: usize,

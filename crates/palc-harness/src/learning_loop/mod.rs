@@ -495,13 +495,14 @@ impl LearningLoop {
         let mut lesson = lesson(self.policy.method, setup, drive, takeover_step, feature_set)?;
         let driven_l: Vec<f64> = drive.driven.iter().map(|x| x.l).collect();
         let planned_l: Vec<f64> = drive.plan.states.iter().map(|x| x.l).collect();
-        let demonstration = learner.personalization.demonstrate(&LessonPaths {
-            driven_l: &driven_l,
-            planned_l: &planned_l,
+        let paths = LessonPaths::new(
+            &driven_l,
+            &planned_l,
             takeover_step,
-            dt: setup.dt,
-            target_l: setup.target_l,
-        });
+            setup.dt,
+            setup.target_l,
+        );
+        let demonstration = learner.personalization.demonstrate(&paths);
         if let Some(path) = &demonstration.path {
             let mut states = lesson.executed.clone();
             for (state, &l) in states.iter_mut().zip(path) {

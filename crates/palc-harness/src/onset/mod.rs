@@ -1,5 +1,6 @@
 //! The user's start of a lane change in relative space: observed in a lesson,
-//! predicted in a new scene (docs/paper-mapping.md, "Experience in relative space").
+//! predicted in a new scene (docs/experiments/0042-observing-the-users-start.md,
+//! docs/experiments/0043-predicting-the-start.md).
 //!
 //! A takeover shows the user's own lateral profile from the takeover on. Its start
 //! is found by fitting a lane-change model through two crossings of it ([`Shape`]):

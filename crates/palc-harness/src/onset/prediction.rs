@@ -56,9 +56,10 @@ fn ttc(s: &Situation) -> Option<f64> {
 /// not at all (a decision that came later), and one scene cannot tell. Read as
 /// a wait, such a start only bounded the decision from below and required the
 /// follower gap it had; read as a free start, its relative state is the
-/// decision. Over every pair of the transfer matrix (docs/paper-mapping.md) the
-/// second reading needs fewer takeovers with experience for every start rule
-/// than the first did with a window of 1 s (deterministic users 190 -> 165).
+/// decision. Over every pair of the transfer matrix
+/// (docs/experiments/0054-which-starts-were-waits.md) the second reading needs
+/// fewer takeovers with experience for every start rule than the first did with a
+/// window of 1 s (deterministic users 190 -> 165).
 fn held_back(setup: &Setup, step: usize, gap: fn(&Situation) -> Option<f64>) -> bool {
     let present_at_start = gap(&setup.situations[step]).is_some();
     let opened_now = step
@@ -156,16 +157,18 @@ fn waited_for_the_follower(setup: &Setup, step: usize) -> bool {
 /// there, mistook a wait for the leader for an undecided user: over every pair of
 /// the transfer matrix (deterministic users) the carried start was right to the
 /// step in 158 of 246 pairs across speed cases instead of 145, and the
-/// time-to-collision users' 93 of 220 instead of 66 (docs/paper-mapping.md).
+/// time-to-collision users' 93 of 220 instead of 66
+/// (docs/experiments/0045-what-the-user-refused.md).
 ///
 /// When the gaps were never open before the follower came, that step is the
 /// fallback: the earliest start the wait allows, the upper end of the interval
 /// the prediction weighs ([`predicted_start_s`]). Without a ceiling the decision
 /// kept only its lower bound, the latest start the wait allows; with the fallback the transfer
 /// matrix's pairs need 190 takeovers instead of 197 (deterministic users), and
-/// fewer or as many for every start rule (docs/paper-mapping.md). `None` when the
-/// follower was not alongside at the step before the start, or was alongside
-/// from the scene's first step.
+/// fewer or as many for every start rule
+/// (docs/experiments/0045-what-the-user-refused.md). `None` when the follower was
+/// not alongside at the step before the start, or was alongside from the scene's
+/// first step.
 fn last_open_step_before_alongside(setup: &Setup, step: usize) -> Option<usize> {
     let alongside = |i: usize| lag_time_gap(&setup.situations[i]).is_some_and(|g| g <= 0.0);
     let first_alongside = (0..step).rev().take_while(|&i| alongside(i)).last()?;
@@ -343,7 +346,8 @@ fn decision_range(onsets: &[Onset]) -> (Decision, f64, f64) {
 /// decided, at the headway it had there. One scene cannot tell the two readings
 /// apart; a time-to-collision user who decides below the standard ALC's headway
 /// as the follower's gap opens looks like a user who waited for that gap
-/// (docs/paper-mapping.md, "A wait the standard ALC would not make").
+/// (docs/experiments/0060-a-wait-the-standard-alc-would-not-make.md; the reading
+/// again is measured in docs/experiments/0061-a-wait-read-again.md).
 fn reread_follower_waits(onsets: &[Onset]) -> Vec<Onset> {
     let smaller_lag_elsewhere = |i: usize, gap: f64| {
         (onsets.iter().enumerate()).any(|(j, o)| {
