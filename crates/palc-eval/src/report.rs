@@ -363,16 +363,30 @@ fn sensitivity_table(
     let _ = writeln!(out);
 }
 
-/// Refused runs counted by kind and experiment (one line per kind, each with
-/// one example message; every refused run is in `refusals.csv`), then the runs
-/// that stopped on an error.
+/// Refused runs counted by kind and experiment (every refused run is in
+/// `refusals.csv`), then the runs that stopped on an error, counted by the
+/// error's kind (its first clause, e.g. `problem is infeasible`; every one is in
+/// `runs.csv` with its message).
 fn refusals(out: &mut String, rows: &[RunRow]) {
-    let refused: Vec<(String, &RunRow)> = (rows.iter())
-        .filter_map(|r| r.status.refusal_kind().map(|kind| (kind, r)))
+    let refused: Vec<Counted> = (rows.iter())
+        .filter_map(|row| match &row.status {
+            Status::Refused { reason, .. } => Some(Counted {
+                kind: format!("`{}`", row.status.refusal_kind()?),
+                experiment: row.spec.experiment.name(),
+                example: reason.clone(),
+            }),
+            _ => None,
+        })
         .collect();
-    let failed: Vec<&RunRow> = rows
-        .iter()
-        .filter(|r| matches!(r.status, Status::Failed { .. }))
+    let failed: Vec<Counted> = (rows.iter())
+        .filter_map(|row| match &row.status {
+            Status::Failed { error } => Some(Counted {
+                kind: failure_kind(error).to_owned(),
+                experiment: row.spec.experiment.name(),
+                example: format!("`{}`: {error}", row.spec.label()),
+            }),
+            _ => None,
+        })
         .collect();
     let _ = writeln!(out, "## Refused scenarios and failed runs\n");
     let _ = writeln!(
@@ -384,105 +398,64 @@ fn refusals(out: &mut String, rows: &[RunRow]) {
         rows.len(),
         failed.len()
     );
-    let mut experiments: Vec<&str> = Vec::new();
-    let mut kinds: Vec<(&str, &str)> = Vec::new();
-    for (kind, row) in &refused {
-        let experiment = row.spec.experiment.name();
-        if !experiments.contains(&experiment) {
-            experiments.push(experiment);
-        }
-        if !kinds.iter().any(|(k, _)| k == kind) {
-            let example = match &row.status {
-                Status::Refused { reason, .. } => reason.as_str(),
-                _ => "",
-            };
-            kinds.push((kind, example));
-        }
-    }
-    if !kinds.is_empty() {
+    kind_table(out, "kind", &refused);
+    if !failed.is_empty() {
         let _ = writeln!(
             out,
-            "| kind | {} | total | example |",
-            experiments.join(" | ")
+            "Runs that stopped on an error, by the error's kind (the full messages are in `runs.csv`):\n"
         );
-        let _ = writeln!(out, "|{}", " --- |".repeat(experiments.len() + 3));
-        for (kind, example) in &kinds {
-            let count = |experiment: Option<&str>| {
-                (refused.iter())
-                    .filter(|(k, r)| {
-                        k == kind && experiment.is_none_or(|e| r.spec.experiment.name() == e)
-                    })
-                    .count()
-            };
-            let cells: Vec<String> = (experiments.iter())
-                .map(|e| count(Some(e)).to_string())
-                .collect();
-            let _ = writeln!(
-                out,
-                "| `{kind}` | {} | {} | {} |",
-                cells.join(" | "),
-                count(None),
-                example.replace('|', "\\|")
-            );
-        }
-        let _ = writeln!(out);
+        kind_table(out, "error", &failed);
     }
-    failed_runs(out, &failed);
 }
 
-/// Runs that stopped on an error, counted by the error's kind (its first
-/// clause, e.g. `problem is infeasible`) and experiment, each kind with one
-/// example; every one is in `runs.csv` with its message.
-fn failed_runs(out: &mut String, failed: &[&RunRow]) {
-    if failed.is_empty() {
+/// A run counted in a table by kind and experiment.
+struct Counted {
+    kind: String,
+    experiment: &'static str,
+    /// The message of the first run of its kind.
+    example: String,
+}
+
+/// One line per kind (in order of first appearance): its count in each
+/// experiment, the total and the first run's message; nothing without runs.
+fn kind_table(out: &mut String, header: &str, runs: &[Counted]) {
+    let mut experiments: Vec<&str> = Vec::new();
+    let mut kinds: Vec<&Counted> = Vec::new();
+    for run in runs {
+        if !experiments.contains(&run.experiment) {
+            experiments.push(run.experiment);
+        }
+        if !kinds.iter().any(|k| k.kind == run.kind) {
+            kinds.push(run);
+        }
+    }
+    if kinds.is_empty() {
         return;
     }
-    let mut experiments: Vec<&str> = Vec::new();
-    let mut kinds: Vec<(&str, String)> = Vec::new();
-    for row in failed {
-        let Status::Failed { error } = &row.status else {
-            continue;
-        };
-        let experiment = row.spec.experiment.name();
-        if !experiments.contains(&experiment) {
-            experiments.push(experiment);
-        }
-        let kind = failure_kind(error);
-        if !kinds.iter().any(|(k, _)| *k == kind) {
-            kinds.push((kind, format!("`{}`: {error}", row.spec.label())));
-        }
-    }
-    let kind_of = |row: &RunRow| match &row.status {
-        Status::Failed { error } => Some(failure_kind(error).to_owned()),
-        _ => None,
-    };
     let _ = writeln!(
         out,
-        "Runs that stopped on an error, by the error's kind (the full messages are in `runs.csv`):\n"
-    );
-    let _ = writeln!(
-        out,
-        "| error | {} | total | example |",
+        "| {header} | {} | total | example |",
         experiments.join(" | ")
     );
     let _ = writeln!(out, "|{}", " --- |".repeat(experiments.len() + 3));
-    for (kind, example) in &kinds {
-        let count = |experiment: Option<&str>| {
-            (failed.iter())
-                .filter(|r| kind_of(r).as_deref() == Some(*kind))
-                .filter(|r| experiment.is_none_or(|e| r.spec.experiment.name() == e))
-                .count()
-        };
+    for first in kinds {
+        let of_kind: Vec<&Counted> = runs.iter().filter(|r| r.kind == first.kind).collect();
         let cells: Vec<String> = (experiments.iter())
-            .map(|e| count(Some(e)).to_string())
+            .map(|&e| {
+                of_kind
+                    .iter()
+                    .filter(|r| r.experiment == e)
+                    .count()
+                    .to_string()
+            })
             .collect();
         let _ = writeln!(
             out,
             "| {} | {} | {} | {} |",
-            kind.replace('|', "\\|"),
+            first.kind.replace('|', "\\|"),
             cells.join(" | "),
-            count(None),
-            example.replace('|', "\\|")
+            of_kind.len(),
+            first.example.replace('|', "\\|")
         );
     }
     let _ = writeln!(out);

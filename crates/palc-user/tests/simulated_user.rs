@@ -143,3 +143,61 @@ fn a_user_is_send_so_loops_can_run_on_threads() {
     let handle = std::thread::spawn(move || user.name().to_owned());
     assert_eq!(handle.join().unwrap(), "probe");
 }
+
+mod properties {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 64, ..ProptestConfig::default() })]
+
+        /// Any valid style on the closing scene starts where its headway is first
+        /// reached, ends on the target lane and never leaves the two lanes; moving
+        /// the whole scene along the road changes the start by nothing.
+        #[test]
+        fn a_style_starts_at_its_headway_wherever_the_scene_is(
+            headway in 0.9f64..2.0,
+            duration in 1.5f64..4.0,
+            shift in -500.0f64..500.0,
+        ) {
+            let (situations, lane_keeping) = scene_steps(300, None);
+            let style = Style {
+                time_headway_s: headway,
+                lane_change_duration_s: duration,
+                ..Style::NEUTRAL
+            };
+            let user = SimulatedUser::paper(style).unwrap();
+            let expectation = user.nominal(&scene(&situations, &lane_keeping)).unwrap();
+            let first = situations.iter().position(|s| s.time_headway_s <= headway).unwrap();
+            prop_assert_eq!(expectation.start_step, first);
+            let lane_change = &expectation.lane_change;
+            prop_assert!((lane_change.lateral(lane_change.end_s()) - 3.5).abs() < 1e-9);
+            prop_assert!(expectation.states.iter().all(|x| (-1.75..=5.25).contains(&x.l)));
+            let shifted: Vec<[f64; 2]> =
+                lane_keeping.iter().map(|&[s, v]| [s + shift, v]).collect();
+            let moved = user.nominal(&scene(&situations, &shifted)).unwrap();
+            prop_assert_eq!(moved.start_step, expectation.start_step);
+            prop_assert_eq!(&moved.lane_change, &expectation.lane_change);
+        }
+
+        /// The RSS safe distance grows with the rear vehicle's speed and shrinks
+        /// with the front one's, and is never negative.
+        #[test]
+        fn the_safe_distance_is_monotone_and_never_negative(
+            rear in 0.0f64..50.0,
+            front in 0.0f64..50.0,
+            faster in 0.0f64..10.0,
+        ) {
+            let rss = SafeDistance {
+                response_time_s: 0.5,
+                max_acceleration_mps2: 1.5,
+                min_braking_mps2: 6.0,
+                max_braking_mps2: 6.0,
+            };
+            let d = rss.distance(rear, front);
+            prop_assert!(d >= 0.0);
+            prop_assert!(rss.distance(rear + faster, front) >= d);
+            prop_assert!(rss.distance(rear, front + faster) <= d);
+        }
+    }
+}
