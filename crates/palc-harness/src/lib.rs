@@ -1,11 +1,14 @@
-//! Simulated users and the lesson-learning loop (paper Section II.A and Fig. 2):
-//! plan, execute in traffic, let the user take over, learn, repeat.
+//! The lesson-learning loop (paper Section II.A and Fig. 2): plan, execute in
+//! traffic, let the user take over, learn, repeat.
 //!
 //! The loop ties the other crates together: [`palc_traffic`] moves the background
-//! traffic, [`palc_planner`] plans each lane change, the user of [`user`] judges
-//! it step by step, and on a takeover [`palc_aggregator`] (with
-//! [`palc_zone_filter`]) learns from the lesson. Two methods run side by side
-//! ([`Method`]): the paper's, with only its equation errors corrected, and palc's.
+//! traffic, [`palc_planner`] plans each lane change, a [`User`] (the `palc-user`
+//! crate, re-exported as [`user`]) judges it step by step, and on a takeover
+//! [`palc_aggregator`] (with [`palc_zone_filter`]) learns from the lesson. Two
+//! methods run side by side ([`Method`]): the paper's, with only its equation
+//! errors corrected, and palc's; how each turns a lesson into a demonstration and
+//! carries experience is an [`advanced::Personalization`]. A scenario that does
+//! not fit the planning set-up is refused with a typed [`Refusal`].
 //!
 //! The loop is an executor, [`LearningLoop`]: `new` prepares a scenario, `step`
 //! drives one lane change and learns from a takeover, `termination` applies the
