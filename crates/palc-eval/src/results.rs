@@ -238,40 +238,75 @@ impl RunRow {
     }
 }
 
+/// The columns of `refusals.csv`, in the order of [`RefusalCsvRow`]'s fields.
+const REFUSAL_COLUMNS: [&str; 10] = [
+    "id",
+    "experiment",
+    "method",
+    "user",
+    "style",
+    "speed_case",
+    "headway_m",
+    "seed",
+    "kind",
+    "reason",
+];
+
+/// One line of `refusals.csv`.
+#[derive(Debug, Serialize)]
+struct RefusalCsvRow<'a> {
+    id: usize,
+    experiment: &'a str,
+    method: &'a str,
+    user: &'a str,
+    style: &'a str,
+    speed_case: &'a str,
+    headway_m: f64,
+    seed: u64,
+    kind: String,
+    reason: &'a str,
+}
+
 /// Writes `refusals.csv`: one line per refused run, with its kind and message
-/// (REPORT.md counts them by kind and experiment).
+/// (REPORT.md counts them by kind and experiment); the header also without any.
 pub fn write_refusals(rows: &[RunRow], path: &Path) -> Result<(), EvalError> {
-    let mut bytes = Vec::new();
-    let mut writer = csv::Writer::from_writer(&mut bytes);
-    writer.write_record([
-        "id",
-        "experiment",
-        "method",
-        "user",
-        "style",
-        "speed_case",
-        "headway_m",
-        "seed",
-        "kind",
-        "reason",
-    ])?;
-    for row in rows {
-        let (Some(kind), Status::Refused { reason, .. }) = (row.status.refusal_kind(), &row.status)
-        else {
-            continue;
+    let lines = rows.iter().filter_map(|row| {
+        let Status::Refused { reason, .. } = &row.status else {
+            return None;
         };
-        writer.write_record([
-            row.spec.id.to_string().as_str(),
-            row.spec.experiment.name(),
-            row.spec.method.name(),
-            &row.spec.user.name,
-            row.spec.style.name(),
-            &row.spec.speed_case.name,
-            &row.spec.headway_m.to_string(),
-            &row.spec.seed.to_string(),
-            &kind,
+        Some(RefusalCsvRow {
+            id: row.spec.id,
+            experiment: row.spec.experiment.name(),
+            method: row.spec.method.name(),
+            user: &row.spec.user.name,
+            style: row.spec.style.name(),
+            speed_case: &row.spec.speed_case.name,
+            headway_m: row.spec.headway_m,
+            seed: row.spec.seed,
+            kind: row.status.refusal_kind()?,
             reason,
-        ])?;
+        })
+    });
+    write_csv(path, Some(&REFUSAL_COLUMNS), lines)
+}
+
+/// Writes `lines` as CSV to `path` through the atomic writer, under `header`
+/// when given (kept when there are no lines), else under the header serde
+/// derives from the first line.
+fn write_csv<T: Serialize>(
+    path: &Path,
+    header: Option<&[&str]>,
+    lines: impl IntoIterator<Item = T>,
+) -> Result<(), EvalError> {
+    let mut bytes = Vec::new();
+    let mut writer = csv::WriterBuilder::new()
+        .has_headers(header.is_none())
+        .from_writer(&mut bytes);
+    if let Some(header) = header {
+        writer.write_record(header)?;
+    }
+    for line in lines {
+        writer.serialize(line)?;
     }
     writer.flush().map_err(csv::Error::from)?;
     drop(writer);
@@ -321,15 +356,13 @@ struct CsvRow<'a> {
 pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> Result<(), EvalError> {
     let text = serde_json::to_string_pretty(rows)?;
     palc_aggregator::output::write(json, text.as_bytes())?;
-    let mut bytes = Vec::new();
-    let mut writer = csv::Writer::from_writer(&mut bytes);
-    for row in rows {
+    let lines = rows.iter().map(|row| {
         let note = match &row.status {
             Status::Refused { reason, .. } => reason.clone(),
             Status::Failed { error } => error.clone(),
             _ => String::new(),
         };
-        writer.serialize(CsvRow {
+        CsvRow {
             id: row.spec.id,
             experiment: row.spec.experiment.name(),
             method: row.spec.method.name(),
@@ -363,12 +396,9 @@ pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> Result<(), EvalEr
             min_gap_target_lag_m: row.min_of(|s| s.min_gap_target_lag_m),
             min_ttc_s: row.min_of(SafetyMetrics::min_ttc_s),
             note,
-        })?;
-    }
-    writer.flush().map_err(csv::Error::from)?;
-    drop(writer);
-    palc_aggregator::output::write(csv_path, &bytes)?;
-    Ok(())
+        }
+    });
+    write_csv(csv_path, None, lines)
 }
 
 #[cfg(test)]
@@ -441,6 +471,10 @@ mod tests {
         assert!(json["refusal"]["kind"].is_string(), "{json}");
         let back: Status = serde_json::from_value(json).unwrap();
         assert_eq!(&back, &typed.status);
+        // Without refusals the file still names its columns.
+        write_refusals(&[], &path).unwrap();
+        let empty = std::fs::read_to_string(&path).unwrap();
+        assert_eq!(empty.lines().count(), 1, "{empty}");
         std::fs::remove_dir_all(&dir).unwrap();
     }
 

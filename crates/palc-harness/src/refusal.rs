@@ -236,3 +236,154 @@ impl Refusal {
         kind.to_owned()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::violation::Role;
+
+    /// One refusal of every kind, the user's refusals included.
+    fn every_refusal() -> Vec<Refusal> {
+        let user = |refusal| Refusal::User {
+            user: "probe".into(),
+            refusal,
+        };
+        vec![
+            Refusal::NoEgo,
+            Refusal::EgoNotMoving { speed_mps: 0.0 },
+            Refusal::NoPreceding,
+            Refusal::NeverTriggers {
+                trigger_time_headway_s: 2.2,
+                max_approach_s: 60.0,
+            },
+            Refusal::StoppedBeforeTrigger { speed_mps: 0.0 },
+            Refusal::StandardNeverStarts { window_s: 60.0 },
+            Refusal::StyleNeverStarts {
+                time_headway_s: 1.2,
+                window_s: 60.0,
+            },
+            Refusal::StandardGapsUnsafe {
+                duration_s: 3.5,
+                window_s: 60.0,
+            },
+            Refusal::StandardBehindPreceding {
+                duration_s: 3.5,
+                window_s: 60.0,
+                time_headway_s: -0.1,
+                delay_steps: 5,
+            },
+            Refusal::HorizonBeyondWindow {
+                horizon: 700,
+                window: 600,
+            },
+            Refusal::LaneChangeBeyondWindow {
+                end_s: 61.0,
+                needed: 620,
+                window: 600,
+            },
+            Refusal::StyleNotWithinHorizon {
+                style: "neutral".into(),
+            },
+            Refusal::StandardNotLater {
+                standard_start_s: 5.0,
+                style: "neutral".into(),
+                user_start_s: 5.0,
+            },
+            Refusal::StandardNotSlower {
+                standard_duration_s: 3.5,
+                style: "neutral".into(),
+                user_duration_s: 3.5,
+            },
+            Refusal::OwnLaneChangeTakenOver {
+                user: "probe".into(),
+                step: 12,
+                cause: TakeoverCause::Deviation,
+            },
+            Refusal::OwnLaneChangeCollides {
+                user: "probe".into(),
+                vehicles: "the preceding vehicle at -0.2 m".into(),
+            },
+            Refusal::OwnLaneChangeEntersBeside {
+                user: "probe".into(),
+                step: 40,
+            },
+            Refusal::StandardPlanUnsafe {
+                violation: Violation {
+                    step: 30,
+                    role: Role::TargetLag,
+                    vehicle: 3,
+                    gap_m: 4.0,
+                    safe_distance_m: 9.0,
+                },
+            },
+            Refusal::DrawBeyondHorizon {
+                user: "probe".into(),
+                start_s: 9.0,
+                duration_s: 3.0,
+                horizon_s: 11.0,
+            },
+            user(UserRefusal::StartRuleNeverMet {
+                rule: "time-headway".into(),
+                window_s: 60.0,
+            }),
+            user(UserRefusal::StartRuleMetAtTrigger {
+                rule: "time-headway".into(),
+                time_headway_s: 1.0,
+            }),
+            user(UserRefusal::GapsNeverAcceptable {
+                min_lead_gap_s: 0.6,
+                min_lag_gap_s: 0.0,
+                safe_distance: true,
+                decision_step: 20,
+            }),
+            user(UserRefusal::EndsAfterWindow {
+                end_s: 61.0,
+                window_s: 60.0,
+            }),
+            user(UserRefusal::NotCentreToCentre {
+                start_l: 0.1,
+                end_l: 3.2,
+                from_l: 0.0,
+                to_l: 3.5,
+            }),
+            user(UserRefusal::LeavesLanes {
+                l: 6.0,
+                low: -1.75,
+                high: 5.25,
+            }),
+            user(UserRefusal::NotSmooth {
+                profile: "table".into(),
+                duration_s: 1.0,
+                acceleration_mps2: 12.0,
+                max_acceleration_mps2: 10.0,
+                jerk_mps3: 200.0,
+                max_jerk_mps3: 150.0,
+            }),
+            user(UserRefusal::NoSpreadGenerator),
+        ]
+    }
+
+    #[test]
+    fn each_kind_is_the_name_runs_json_gives_it_and_reads_back() {
+        let refusals = every_refusal();
+        let mut kinds: Vec<String> = Vec::new();
+        for refusal in &refusals {
+            let json = serde_json::to_value(refusal).unwrap();
+            let tag = json["kind"].as_str().unwrap();
+            let expected = match refusal {
+                Refusal::User { .. } => {
+                    format!("user/{}", json["refusal"]["kind"].as_str().unwrap())
+                }
+                _ => tag.to_owned(),
+            };
+            assert_eq!(refusal.kind(), expected);
+            assert!(!refusal.to_string().is_empty());
+            let back: Refusal = serde_json::from_value(json).unwrap();
+            assert_eq!(&back, refusal);
+            kinds.push(refusal.kind());
+        }
+        kinds.sort();
+        kinds.dedup();
+        assert_eq!(kinds.len(), refusals.len(), "two refusals share a kind");
+    }
+}
