@@ -1,0 +1,1 @@
+//! Writing CommonRoad scenarios and solution files.

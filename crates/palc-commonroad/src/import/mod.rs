@@ -1,0 +1,1 @@
+//! Reading CommonRoad scenarios and finding their lane changes.
