@@ -39,6 +39,11 @@ enum Command {
     Zone(commands::zone::ZoneArgs),
     /// Simulated users: the lane change a user expects, before learning starts.
     User(commands::user::UserArgs),
+    /// Bring recorded traffic into palc (`palc import commonroad SCENARIO.xml...`).
+    Import(commands::import::ImportArgs),
+    /// Write palc's scenes and learned lane changes for other tools
+    /// (`palc export commonroad`).
+    Export(commands::export::ExportArgs),
 }
 
 fn main() -> ExitCode {
@@ -50,6 +55,8 @@ fn main() -> ExitCode {
         Command::Plan(args) => commands::plan::run(args),
         Command::Zone(args) => commands::zone::run(args),
         Command::User(args) => commands::user::run(args),
+        Command::Import(args) => commands::import::run(args),
+        Command::Export(args) => commands::export::run(args),
     };
     let result = result.and_then(|()| match console::failure() {
         Some(error) => Err(anyhow::Error::new(error).context("cannot write to the terminal")),

@@ -1,6 +1,8 @@
 //! One module per `palc` subcommand.
 
 pub mod eval;
+pub mod export;
+pub mod import;
 pub mod learn;
 pub mod plan;
 pub mod traffic;
