@@ -38,6 +38,7 @@ mod error;
 mod expectation;
 mod family;
 mod profile;
+mod recorded;
 mod scene;
 mod simulated;
 mod situation;
@@ -59,6 +60,9 @@ pub use family::{
 pub use profile::{
     LateralProfile, MAX_TABLE_POINTS, PEAK_FRACTION_BOUNDS, ProfilePoint, TABLE_END_TOLERANCE_M,
     quintic,
+};
+pub use recorded::{
+    DEFAULT_NOISE_M, MIN_MOVE_M, NOISE_BOUNDS_M, OUTLIER_NOISE_FACTOR, RecordedFit, RecordedProfile,
 };
 pub use scene::{SafeDistance, UserScene};
 pub use simulated::{MAX_DRAWS, SimulatedUser};

@@ -19,10 +19,14 @@
 //!   driver or another simulator, interpolated by the monotone piecewise cubic
 //!   of Fritsch and Carlson (1980): monotone data stays monotone, no overshoot.
 //!   The table sets its own duration (its last time) and offset (its last point).
+//! - **recorded**: noisy samples of a recorded lane change (10–25 Hz), smoothed
+//!   into the smoothest monotone shape within the samples' stated noise
+//!   ([`RecordedProfile`]); the user drives, and is checked on, the smoothed shape.
 
 use serde::{Deserialize, Serialize};
 
 use crate::UserError;
+use crate::recorded::RecordedProfile;
 
 /// Smallest and largest `peak_fraction` of the asymmetric profile.
 /// At the bounds the peak lateral acceleration is 1.67 times the quintic's.
@@ -58,6 +62,10 @@ pub enum LateralProfile {
         /// [`PEAK_FRACTION_BOUNDS`]; 0.5 is the quintic.
         peak_fraction: f64,
     },
+    /// Noisy samples of a recorded lane change, smoothed into a monotone shape
+    /// (see [`RecordedProfile`]); the user stretches it over its duration and
+    /// the scene's lane width, as the analytic shapes.
+    Recorded(RecordedProfile),
     /// Points `(time since start, lateral offset)`, interpolated monotonically.
     Table {
         /// At least two points, times strictly increasing from 0, offsets from 0.
@@ -73,6 +81,7 @@ impl LateralProfile {
             LateralProfile::Cosine => "cosine",
             LateralProfile::Asymmetric { .. } => "asymmetric",
             LateralProfile::Table { .. } => "table",
+            LateralProfile::Recorded(_) => "recorded",
         }
     }
 
@@ -85,6 +94,7 @@ impl LateralProfile {
         };
         match self {
             LateralProfile::Quintic | LateralProfile::Cosine => Ok(()),
+            LateralProfile::Recorded(recorded) => recorded.fit(table).map(|_| ()),
             LateralProfile::Asymmetric { peak_fraction } => {
                 let (low, high) = PEAK_FRACTION_BOUNDS;
                 if peak_fraction.is_finite() && (low..=high).contains(peak_fraction) {
@@ -178,6 +188,7 @@ impl LateralProfile {
             LateralProfile::Quintic | LateralProfile::Table { .. } => quintic(tau),
             LateralProfile::Cosine => 0.5 * (1.0 - (std::f64::consts::PI * tau).cos()),
             LateralProfile::Asymmetric { peak_fraction } => asymmetric(tau, *peak_fraction),
+            LateralProfile::Recorded(recorded) => recorded.progress(tau),
         }
     }
 }
@@ -408,5 +419,32 @@ mod tests {
             err.contains("user.profile.peak_fraction") && err.contains("0.95"),
             "{err}"
         );
+    }
+}
+
+#[cfg(test)]
+mod recorded_tests {
+    use super::*;
+
+    #[test]
+    fn a_recorded_profile_reads_from_toml_and_drives_its_fit() {
+        let mut text = String::from("shape = \"recorded\"\nnoise_m = 0.05\nsamples = [\n");
+        for i in 0..=30 {
+            let t = i as f64 * 0.1;
+            let wobble = 0.03 * (i as f64 * 2.1).sin();
+            let offset = 3.6 * quintic(t / 3.0) + wobble;
+            text.push_str(&format!("{{ time_s = {t}, offset_m = {offset} }},\n"));
+        }
+        text.push(']');
+        let profile: LateralProfile = toml::from_str(&text).unwrap();
+        assert_eq!(profile.name(), "recorded");
+        profile.validate("user.family.profile").unwrap();
+        assert_eq!(profile.own_duration_s(), None);
+        // Stretched over the user's duration and the scene's offset.
+        assert!(profile.offset_at(0.0, 2.0, 3.5).abs() < 1e-9);
+        assert!((profile.offset_at(2.0, 2.0, 3.5) - 3.5).abs() < 1e-9);
+        assert!((profile.offset_at(1.0, 2.0, 3.5) - 1.75).abs() < 0.15);
+        let unknown = toml::from_str::<LateralProfile>(&text.replace("noise_m", "noise"));
+        assert!(unknown.is_err());
     }
 }
