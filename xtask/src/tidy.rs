@@ -187,6 +187,7 @@ const DEPENDENCY_RULES: &[(&str, &[&str], bool)] = &[
     ("palc-traffic", &[], true),
     ("palc-zone-filter", &[], true),
     ("palc-planner", &[], true),
+    ("palc-commonroad", &[], true),
     (
         "palc-aggregator",
         &["palc-zone-filter", "palc-planner"],

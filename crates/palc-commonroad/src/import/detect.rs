@@ -45,6 +45,13 @@ struct Candidate {
     end: usize,
 }
 
+/// `x` rounded to a multiple of `unit` (the file's resolution: 0.1 mm, 1e-4 m/s, 1 µs), so that a trace's times are the step's multiples, not `0.30000000000000004`.
+fn round(x: f64, unit: f64) -> f64 {
+    let r = (x / unit).round() * unit;
+    // Printing through a decimal string gives the double nearest to the rounded decimal.
+    format!("{r:.10}").parse().unwrap_or(r)
+}
+
 /// The sign that turns a left-positive offset into one positive towards the target.
 fn sign(direction: Direction) -> f64 {
     match direction {
@@ -59,7 +66,10 @@ fn sign(direction: Direction) -> f64 {
 pub(crate) fn lateral_speed(y: &[f64], dt: f64, half: usize) -> Vec<f64> {
     (0..y.len())
         .map(|i| {
-            let (a, b) = (i.saturating_sub(half), (i + half).min(y.len() - 1));
+            let (a, b) = (
+                i.saturating_sub(half),
+                i.saturating_add(half).min(y.len() - 1),
+            );
             let count = b - a + 1;
             if count < LATERAL_SPEED_MIN_SAMPLES {
                 return f64::NAN;
@@ -127,7 +137,7 @@ pub(crate) fn lane_changes(
             };
             mark(
                 j.saturating_sub(exclusion),
-                i + exclusion,
+                i.saturating_add(exclusion),
                 &mut excluded[ti],
             );
             let Some(crossing) = crossing.filter(|&k| v[k] > LATERAL_SPEED_THRESHOLD_MPS) else {
@@ -244,10 +254,10 @@ fn describe(
     }
     counts.lane_changes += 1;
     let margin = (TRACE_MARGIN_S / dt).round() as usize;
-    let trace = (c.start.saturating_sub(margin)..=(c.end + margin).min(n - 1))
+    let trace = (c.start.saturating_sub(margin)..=c.end.saturating_add(margin).min(n - 1))
         .map(|k| LateralSample {
-            time_s: (k as f64 - c.start as f64) * dt,
-            lateral_m: y[k],
+            time_s: round((k as f64 - c.start as f64) * dt, 1e-6),
+            lateral_m: round(y[k], 1e-4),
         })
         .collect();
     let start_step = track.first_step + c.start as i64;
@@ -262,9 +272,10 @@ fn describe(
         let net_gap_m = ds.abs() - (track.length + other.length) / 2.0;
         Neighbour {
             vehicle_id: other.id,
-            net_gap_m,
-            closing_speed_mps: closing,
-            time_headway_s: (v_ego >= HEADWAY_MIN_SPEED_MPS).then(|| net_gap_m / v_ego),
+            net_gap_m: round(net_gap_m, 1e-4),
+            closing_speed_mps: round(closing, 1e-4),
+            time_headway_s: (v_ego >= HEADWAY_MIN_SPEED_MPS)
+                .then(|| round(net_gap_m / v_ego, 1e-4)),
         }
     };
     let closer = |current: &Option<Neighbour>, candidate: &Neighbour| {
@@ -313,10 +324,10 @@ fn describe(
         direction: c.direction,
         start_lanelet: map.lanelets[c.from].id,
         target_lanelet: map.lanelets[c.to].id,
-        duration_s: (c.end - c.start) as f64 * dt,
-        peak_lateral_speed_mps: peak,
-        speed_at_start_mps: v_ego,
-        lane_width_m: width,
+        duration_s: round((c.end - c.start) as f64 * dt, 1e-6),
+        peak_lateral_speed_mps: round(peak, 1e-4),
+        speed_at_start_mps: round(v_ego, 1e-4),
+        lane_width_m: round(width, 1e-4),
         context,
         merge,
         centre_source: if offsets[c.from].is_some() {
