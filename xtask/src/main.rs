@@ -8,6 +8,8 @@
 //! safety layer (`configs/reproduce-safe.toml`, into `safe/`), the stress scenes
 //! (`configs/stress/`, into `stress/<scene>/`) and `palc` on held-out seeds
 //! (`configs/reproduce-held-out.toml`, into `held-out/`).
+//! `test` runs every test: `cargo test --workspace`, then the Python checks of
+//! the CommonRoad export (`test_all.rs`).
 //! Repository hygiene lives in `tidy.rs` as ordinary tests, run by
 //! `cargo test --workspace`.
 
@@ -16,6 +18,7 @@ use std::process::Command;
 
 use anyhow::Context;
 
+mod test_all;
 #[cfg(test)]
 mod tidy;
 
@@ -31,6 +34,7 @@ fn main() -> anyhow::Result<()> {
             Ok(())
         }
         Some("reproduce-paper") => reproduce_paper(args),
+        Some("test") => test_all::run(args),
         Some(other) => {
             print_help();
             anyhow::bail!("unknown task `{other}`")
@@ -45,6 +49,9 @@ fn print_help() {
          the same as `palc eval` in a release build, then (without --config)\n                   \
          configs/reproduce-safe.toml into DIR/safe, configs/stress/* into DIR/stress\n                   \
          and configs/reproduce-held-out.toml into DIR/held-out\n  \
+         test             every test: cargo test --workspace, then the Python checks of the\n                   \
+         CommonRoad export (a venv in target/venv, palc export commonroad, pytest python);\n                   \
+         --python runs only the Python checks\n  \
          help             this text"
     );
 }

@@ -50,6 +50,17 @@ impl VehicleType {
         }
     }
 
+    /// Distance from the rear axle to the centre, `b` (m), from
+    /// commonroad-vehicle-models' parameter files; CommonRoad's checker moves a
+    /// KS state's centre this far back along the heading to the rear axle.
+    pub fn rear_axle_to_centre(self) -> f64 {
+        match self {
+            VehicleType::FordEscort => 1.508_76,
+            VehicleType::Bmw320i => 1.422_717_093_6,
+            VehicleType::VwVanagon => 1.321_136_397_6,
+        }
+    }
+
     /// Distance between the axles, `a + b` (m), from commonroad-vehicle-models'
     /// parameter files (`parameters_vehicle1..3`): the BMW 320i's is
     /// 1.156 + 1.423 = 2.579 m.

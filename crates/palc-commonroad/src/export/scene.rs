@@ -88,6 +88,20 @@ impl Pose {
             ..self
         }
     }
+
+    /// The centre of a vehicle whose rear axle is at this pose: `rear_to_centre`
+    /// (the model's `b`, [`crate::export::VehicleType::rear_axle_to_centre`])
+    /// ahead along the heading. The kinematic single-track model moves the rear
+    /// axle along the heading, so a path planned with that model (`y' = v ψ`, as
+    /// palc's planner does) is the rear axle's.
+    pub fn centre_from_rear_axle(self, rear_to_centre: f64) -> Pose {
+        let (sin, cos) = self.orientation.sin_cos();
+        Pose {
+            x: self.x + rear_to_centre * cos,
+            y: self.y + rear_to_centre * sin,
+            ..self
+        }
+    }
 }
 
 /// The state of an obstacle at one time step (its centre).
