@@ -13,5 +13,8 @@
 //! trajectories in plain numbers, and the command line maps palc's scenes onto
 //! them.
 
+#![deny(missing_docs)]
+#![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
+
 pub mod export;
 pub mod import;

@@ -114,6 +114,16 @@ pub struct UserKind {
     /// user when left out.
     #[serde(default)]
     pub family: Option<Family>,
+    /// A file of recorded lane changes (`palc import commonroad`), relative to
+    /// the evaluation config: every lane change becomes a driver with its own
+    /// shape, duration and start context, run in place of the grid's styles
+    /// (`recorded_drivers` says how).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub recorded: Option<PathBuf>,
+    /// The recorded driver of one run (its lane change's id), set by the plan;
+    /// never in a config.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub driver: Option<String>,
 }
 
 impl UserKind {
@@ -124,6 +134,8 @@ impl UserKind {
             spread_relative: None,
             spread_parameters: None,
             family: None,
+            recorded: None,
+            driver: None,
         }
     }
 
@@ -132,7 +144,12 @@ impl UserKind {
     /// report gives such kinds one row each in its user-family table, and the
     /// paper's kinds a section each.
     pub fn is_family(&self) -> bool {
-        self.family.is_some() || self.spread_parameters.is_some()
+        self.family.is_some() || self.spread_parameters.is_some() || self.recorded.is_some()
+    }
+
+    /// Whether the kind has a family or spread of its own (besides recorded drivers).
+    fn is_family_of_its_own(&self) -> bool {
+        self.family.is_some() || self.has_spread()
     }
 
     /// Whether any parameter is drawn per lane change.
@@ -243,6 +260,9 @@ pub struct Selection {
     pub example: ExampleConfig,
     /// The ablation ladder's users and rungs.
     pub ablation: AblationConfig,
+    /// The accepted drivers of each recorded user kind, by kind name: each runs
+    /// in place of the grid's styles. Filled when the recorded files are read.
+    pub drivers: std::collections::BTreeMap<String, Vec<String>>,
 }
 
 /// Parses TOML text; an error names the dotted path of the field it is in (e.g.
@@ -280,6 +300,7 @@ impl EvalConfig {
                 timing: self.timing.clone(),
                 example: self.example.clone(),
                 ablation: self.ablation.clone(),
+                drivers: Default::default(),
             });
         }
         let users = (self.quick.users.iter())
@@ -308,6 +329,7 @@ impl EvalConfig {
                 users: quick(&self.ablation.users),
                 ..self.ablation.clone()
             },
+            drivers: Default::default(),
         })
     }
 
@@ -335,6 +357,20 @@ impl EvalConfig {
             ));
         }
         for (i, user) in self.users.iter().enumerate() {
+            if let Some(driver) = &user.driver {
+                return Err(EvalError::invalid(
+                    format!("users[{i}].driver"),
+                    driver,
+                    "nothing: the plan sets each recorded run's driver",
+                ));
+            }
+            if user.recorded.is_some() && user.is_family_of_its_own() {
+                return Err(EvalError::invalid(
+                    format!("users[{i}].recorded"),
+                    user.name.as_str(),
+                    "a kind without family or spread: recorded drivers bring their own style and profile",
+                ));
+            }
             if let Some(spread) = user.spread_relative {
                 if !(spread.is_finite() && (0.0..0.5).contains(&spread)) {
                     return Err(EvalError::invalid(

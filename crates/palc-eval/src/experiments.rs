@@ -118,7 +118,7 @@ pub fn draw_all(
                 "fig08-style",
                 "Fig. 8: mean takeovers by driving style",
                 "style",
-                &|r| r.spec.style.name().to_owned(),
+                &|r| r.spec.style_name().to_owned(),
             ),
             (
                 "fig09-speed",

@@ -47,6 +47,12 @@ fn target_shortfalls(reduction: Option<f64>, frozen: Option<&stats::Frozen>) -> 
 
 /// How a kind's users are built, for the table: its family's rules and its spread.
 fn rules(kind: &UserKind) -> String {
+    if let Some(file) = &kind.recorded {
+        return format!(
+            "recorded drivers of `{}`, each with its own shape, duration and start headway",
+            file.display()
+        );
+    }
     let mut parts = vec![kind.family.clone().unwrap_or_default().describe()];
     if let Some(relative) = kind.spread_relative {
         parts.push(format!("±{:.0} % headway and duration", relative * 100.0));

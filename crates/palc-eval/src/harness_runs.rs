@@ -19,6 +19,7 @@ use serde::Serialize;
 use crate::EvalError;
 use crate::ablation::Rung;
 use crate::plan::{Experiment, RunSpec};
+use crate::recorded_drivers::RecordedDrivers;
 use crate::results::{Iteration, RunRow, Status};
 use crate::runner::Executor;
 
@@ -28,6 +29,7 @@ pub struct HarnessRuns {
     base: LearnConfig,
     testbed: TestbedConfig,
     rungs: Vec<Rung>,
+    recorded: Vec<RecordedDrivers>,
 }
 
 impl HarnessRuns {
@@ -44,6 +46,7 @@ impl HarnessRuns {
             base,
             testbed,
             rungs: Vec::new(),
+            recorded: Vec::new(),
         })
     }
 
@@ -59,6 +62,18 @@ impl HarnessRuns {
         &self.rungs
     }
 
+    /// These runs with the recorded user kinds' drivers, which runs with a
+    /// `driver` take their user from.
+    pub fn with_recorded(mut self, recorded: Vec<RecordedDrivers>) -> HarnessRuns {
+        self.recorded = recorded;
+        self
+    }
+
+    /// The recorded user kinds' drivers.
+    pub fn recorded(&self) -> &[RecordedDrivers] {
+        &self.recorded
+    }
+
     /// The test bed of the base config: speed cases, headways and seeds.
     pub fn testbed(&self) -> &TestbedConfig {
         &self.testbed
@@ -68,7 +83,33 @@ impl HarnessRuns {
     /// user, (timing experiment) step and horizon margin and (ablation) the
     /// rung's label rule and aggregator options.
     pub fn config(&self, spec: &RunSpec) -> Result<LearnConfig, EvalError> {
-        let user = UserConfig {
+        let user = match &spec.user.driver {
+            Some(driver) => self.driver_config(spec, driver)?,
+            None => self.kind_config(spec),
+        };
+        self.config_with_user(spec, user)
+    }
+
+    /// The user of a recorded driver's run.
+    fn driver_config(&self, spec: &RunSpec, driver: &str) -> Result<UserConfig, EvalError> {
+        let drivers = self.recorded.iter().find(|r| r.kind == spec.user.name);
+        let found = drivers.and_then(|r| r.driver(driver));
+        found
+            .map(|d| d.user.clone())
+            .ok_or_else(|| EvalError::Unknown {
+                kind: "recorded driver",
+                name: driver.to_owned(),
+                field: format!("run {}", spec.label()),
+                known: (drivers.into_iter())
+                    .flat_map(|r| r.accepted.iter().map(|d| d.id.clone()))
+                    .collect(),
+            })
+    }
+
+    /// The user of a run of a simulated user kind: the run's style refined by
+    /// the kind's family and spread.
+    fn kind_config(&self, spec: &RunSpec) -> UserConfig {
+        UserConfig {
             spread: spec.user.has_spread().then(|| Spread {
                 relative: spec.user.spread_relative.unwrap_or(0.0),
                 seed: spec.seed,
@@ -76,7 +117,10 @@ impl HarnessRuns {
             }),
             family: spec.user.family.clone(),
             ..UserConfig::preset(spec.style)
-        };
+        }
+    }
+
+    fn config_with_user(&self, spec: &RunSpec, user: UserConfig) -> Result<LearnConfig, EvalError> {
         let mut config = (self.base.clone())
             .with_method(spec.method)
             .with_cell(CellChoice {

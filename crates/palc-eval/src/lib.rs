@@ -44,6 +44,8 @@ pub mod figures;
 pub mod harness_runs;
 pub mod manifest;
 pub mod plan;
+pub mod recorded_drivers;
+pub mod recorded_report;
 pub mod report;
 pub mod results;
 pub mod runner;
@@ -65,6 +67,7 @@ pub use runner::{NoProgress, Progress};
 
 use manifest::Manifest;
 use palc_aggregator::output::{self, Staging};
+use recorded_drivers::RecordedDrivers;
 
 /// What to evaluate and where to write it; the defaults are the paper's
 /// reproduction, run from the workspace root.
@@ -136,7 +139,19 @@ impl Evaluation {
         let selection =
             (config.select(quick, harness.testbed())).map_err(|e| e.in_file(config_path))?;
         let rungs = (selection.ablation.resolve()).map_err(|e| e.in_file(config_path))?;
-        let harness = harness.with_rungs(rungs);
+        let mut selection = selection;
+        let mut recorded = Vec::new();
+        let config_dir = config_path.parent().unwrap_or_else(|| Path::new("."));
+        for kind in &selection.users {
+            let drivers =
+                (RecordedDrivers::load(kind, config_dir)).map_err(|e| e.in_file(config_path))?;
+            recorded.extend(drivers);
+        }
+        for drivers in &recorded {
+            let ids = drivers.accepted.iter().map(|d| d.id.clone()).collect();
+            selection.drivers.insert(drivers.kind.clone(), ids);
+        }
+        let harness = harness.with_rungs(rungs).with_recorded(recorded);
         Ok(Evaluation {
             config_path: config_path.to_owned(),
             base_path,
@@ -268,6 +283,7 @@ pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcom
         figures: &figures,
         manifest: &manifest,
         ablation: (evaluation.harness.rungs(), &selection.ablation.users),
+        recorded: evaluation.harness.recorded(),
     });
     write(&out.join("REPORT.md"), &report_text)?;
     // The example's files of an earlier run are removed when this one has none.

@@ -92,11 +92,20 @@ impl RunSpec {
         (
             self.method.name(),
             self.user.name.clone(),
-            self.style.name().to_owned(),
+            self.style_name().to_owned(),
             self.speed_case.name.clone(),
             self.headway_m.to_bits(),
             self.seed,
         )
+    }
+
+    /// The style in reports: the preset's name, or a recorded run's driver (who
+    /// drives with its own style).
+    pub fn style_name(&self) -> &str {
+        match &self.user.driver {
+            Some(driver) => driver,
+            None => self.style.name(),
+        }
     }
 
     /// A short label for progress lines and error lists.
@@ -110,7 +119,7 @@ impl RunSpec {
             self.experiment.name(),
             method,
             self.user.name,
-            self.style,
+            self.style_name(),
             self.headway_m,
             self.seed,
             self.speed_case.name
@@ -158,10 +167,22 @@ impl RunPlan {
 /// Expands a selection; the timing runs' speed case is looked up in `testbed`.
 pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan, EvalError> {
     let grid = &selection.grid;
+    let drivers = |user: &UserKind| -> &[String] {
+        (selection.drivers.get(&user.name)).map_or(&[], Vec::as_slice)
+    };
     let mut first = Vec::new();
     for method in &grid.methods {
         for user in &selection.users {
-            grid_cells(&mut first, grid, Experiment::Grid, *method, user, None);
+            let drivers = drivers(user);
+            grid_cells(
+                &mut first,
+                grid,
+                Experiment::Grid,
+                *method,
+                user,
+                drivers,
+                None,
+            );
         }
     }
     let timing = &selection.timing;
@@ -214,6 +235,7 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
                 Experiment::Ablation,
                 rung.labels,
                 user,
+                drivers(user),
                 name,
             );
         }
@@ -328,18 +350,35 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
 }
 
 /// Appends a run of `experiment` for every cell of `grid` (speed case x headway x
-/// style x seed, in that order) with this method, user and rung.
+/// style x seed, in that order) with this method, user and rung. A recorded
+/// user kind runs its `drivers` in place of the styles (each with its own
+/// style; the run's preset is the grid's first, unused).
 fn grid_cells(
     runs: &mut Vec<RunSpec>,
     grid: &Grid,
     experiment: Experiment,
     method: Method,
     user: &UserKind,
+    drivers: &[String],
     rung: Option<String>,
 ) {
+    let users: Vec<(StylePreset, UserKind)> = match &user.recorded {
+        Some(_) => (drivers.iter())
+            .map(|driver| {
+                let user = UserKind {
+                    driver: Some(driver.clone()),
+                    ..user.clone()
+                };
+                (grid.styles[0], user)
+            })
+            .collect(),
+        None => (grid.styles.iter())
+            .map(|&style| (style, user.clone()))
+            .collect(),
+    };
     for case in &grid.speed_cases {
         for &headway_m in &grid.headways_m {
-            for style in &grid.styles {
+            for (style, user) in &users {
                 for &seed in &grid.seeds {
                     runs.push(RunSpec {
                         id: runs.len(),
@@ -473,6 +512,37 @@ pub(crate) mod tests {
                 seed: 1,
             },
             ablation: crate::ablation::AblationConfig::default(),
+            drivers: Default::default(),
+        }
+    }
+
+    #[test]
+    fn a_recorded_kind_runs_its_drivers_in_place_of_the_styles_and_transfers_per_driver() {
+        let mut selection = selection();
+        selection.users = vec![UserKind {
+            name: "recorded".into(),
+            recorded: Some("lane-changes.json".into()),
+            ..UserKind::deterministic()
+        }];
+        selection.transfer.users = vec!["recorded".into()];
+        selection
+            .drivers
+            .insert("recorded".into(), vec!["a:1:10".into(), "b:2:20".into()]);
+        let plan = expand(&selection, &testbed()).unwrap();
+        let grid: Vec<&RunSpec> = (plan.first.iter())
+            .filter(|s| s.experiment == Experiment::Grid)
+            .collect();
+        // 2 methods x 2 speed cases x 2 headways x 2 drivers x 2 seeds.
+        assert_eq!(grid.len(), 32);
+        assert!(grid.iter().all(|s| s.user.driver.is_some()));
+        assert_eq!(
+            (grid.iter()).filter(|s| s.style_name() == "b:2:20").count(),
+            16
+        );
+        for target in plan.transfer.iter() {
+            let source = &plan.first[target.experience_from.unwrap()];
+            assert_eq!(source.user.driver, target.user.driver);
+            assert_ne!(source.speed_case, target.speed_case);
         }
     }
 

@@ -31,6 +31,8 @@ pub struct ReportInput<'a> {
     pub manifest: &'a Manifest,
     /// The ablation ladder's rungs and user kinds (empty without ablation runs).
     pub ablation: (&'a [crate::ablation::Rung], &'a [String]),
+    /// The recorded user kinds' drivers.
+    pub recorded: &'a [crate::recorded_drivers::RecordedDrivers],
 }
 
 /// Writes REPORT.md's text.
@@ -67,6 +69,7 @@ pub fn render(input: &ReportInput) -> String {
         user_section(&mut out, input, user);
     }
     crate::families_report::section(&mut out, input.rows, input.methods, input.user_kinds);
+    crate::recorded_report::section(&mut out, input.recorded, input.rows);
     crate::transfer_report::section(&mut out, input.rows, input.methods);
     crate::ablation_report::section(&mut out, input.rows, input.ablation.0, input.ablation.1);
     claims_section(&mut out);
@@ -231,7 +234,7 @@ fn user_section(out: &mut String, input: &ReportInput, user: &str) {
     for (title, key) in [
         (
             "By style",
-            &(|r: &RunRow| r.spec.style.name().to_owned()) as &dyn Fn(&RunRow) -> String,
+            &(|r: &RunRow| r.spec.style_name().to_owned()) as &dyn Fn(&RunRow) -> String,
         ),
         ("By speed case", &speed_label),
         ("By adjacent headway (m)", &|r: &RunRow| {
@@ -654,6 +657,7 @@ mod tests {
             figures: &[],
             manifest: &manifest,
             ablation: (&[], &[]),
+            recorded: &[],
         });
         assert!(
             report

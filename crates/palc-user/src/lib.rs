@@ -37,6 +37,7 @@
 mod error;
 mod expectation;
 mod family;
+mod point;
 mod profile;
 mod recorded;
 mod scene;

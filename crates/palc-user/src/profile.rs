@@ -26,6 +26,7 @@
 use serde::{Deserialize, Serialize};
 
 use crate::UserError;
+pub use crate::point::ProfilePoint;
 use crate::recorded::RecordedProfile;
 
 /// Smallest and largest `peak_fraction` of the asymmetric profile.
@@ -36,16 +37,6 @@ pub const MAX_TABLE_POINTS: usize = 6_000;
 /// Largest gap between the table's last offset and the lane change's offset (m):
 /// a recorded profile ends on the target lane's centre to within a centimetre.
 pub const TABLE_END_TOLERANCE_M: f64 = 0.01;
-
-/// One point of a table profile.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ProfilePoint {
-    /// Time since the start of the lane change (s).
-    pub time_s: f64,
-    /// Lateral offset from the current lane's centre towards the target lane (m).
-    pub offset_m: f64,
-}
 
 /// The shape of the lateral move; see the module documentation.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]

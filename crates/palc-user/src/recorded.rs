@@ -37,7 +37,7 @@ use clarabel::solver::{DefaultSettings, DefaultSolver, IPSolver, SolverStatus, S
 use serde::{Deserialize, Serialize};
 
 use crate::UserError;
-use crate::profile::ProfilePoint;
+use crate::point::ProfilePoint;
 
 /// Degree of the Bernstein polynomial. Seventeen coefficients follow a gradual
 /// onset and an asymmetric end; with the roughness weight chosen from the noise,
@@ -286,11 +286,7 @@ fn check_samples(samples: &[ProfilePoint], noise_m: f64) -> Result<(), InvalidFi
                     samples[i - 1].time_s
                 ),
             };
-            return Err(invalid(
-                format!("samples[{i}].time_s"),
-                point.time_s,
-                bound,
-            ));
+            return Err(invalid(format!("samples[{i}].time_s"), point.time_s, bound));
         }
     }
     let last = samples.len() - 1;
@@ -415,8 +411,8 @@ impl FitProblem {
             value: f64::NAN,
             bound: "samples the smoothing QP can fit (clarabel found no solution)".to_owned(),
         };
-        let mut solver = DefaultSolver::new(&p, &self.linear, &a, &b, &cones, settings)
-            .map_err(|_| failed())?;
+        let mut solver =
+            DefaultSolver::new(&p, &self.linear, &a, &b, &cones, settings).map_err(|_| failed())?;
         solver.solve();
         match solver.solution.status {
             SolverStatus::Solved | SolverStatus::AlmostSolved => Ok(solver.solution.x.clone()),
@@ -507,7 +503,9 @@ mod tests {
     fn the_fit_is_monotone_and_flat_at_both_ends() {
         let profile = RecordedProfile::new(quintic_samples(2.0, 3.5, 25.0, 0.1), 0.1);
         profile.fit("p").unwrap();
-        let path: Vec<f64> = (0..=1000).map(|i| profile.progress(i as f64 / 1000.0)).collect();
+        let path: Vec<f64> = (0..=1000)
+            .map(|i| profile.progress(i as f64 / 1000.0))
+            .collect();
         assert!(path.windows(2).all(|w| w[1] >= w[0] - 1e-9));
         assert!(path[0].abs() < 1e-9 && (path[1000] - 1.0).abs() < 1e-9);
         let h = 1e-3;
