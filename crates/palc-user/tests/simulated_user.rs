@@ -201,3 +201,61 @@ mod properties {
         }
     }
 }
+
+/// A 3.5 m, 3 s quintic lane change sampled at 10 Hz with 5 cm of noise (a
+/// deterministic hash, roughly uniform with that standard deviation), the last
+/// point on the target lane's centre as a table requires.
+fn noisy_samples() -> Vec<palc_user::ProfilePoint> {
+    let noise = |i: usize| {
+        let x = ((i as f64 + 1.0) * 12.9898).sin() * 43_758.545_3;
+        (x - x.floor() - 0.5) * 12f64.sqrt() * 0.05
+    };
+    (0..=30)
+        .map(|i| {
+            let t = i as f64 * 0.1;
+            let edge = i == 0 || i == 30;
+            palc_user::ProfilePoint {
+                time_s: t,
+                offset_m: 3.5 * palc_user::quintic(t / 3.0) + if edge { 0.0 } else { noise(i) },
+            }
+        })
+        .collect()
+}
+
+#[test]
+fn a_noisy_recording_is_refused_as_a_table_and_driven_smoothed_as_recorded() {
+    let (situations, lane_keeping) = scene_steps(200, None);
+    let scene = scene(&situations, &lane_keeping);
+    let style = Style {
+        lane_change_duration_s: 3.0,
+        ..Style::NEUTRAL
+    };
+    let table = Family {
+        profile: palc_user::LateralProfile::Table {
+            points: noisy_samples(),
+        },
+        ..Family::default()
+    };
+    let user = SimulatedUser::new("table", style, table, 0.3, None).unwrap();
+    match user.nominal(&scene) {
+        Err(UserError::Refused {
+            refusal: UserRefusal::NotSmooth {
+                acceleration_mps2, ..
+            },
+            ..
+        }) => assert!(acceleration_mps2 > 10.0, "{acceleration_mps2}"),
+        other => panic!("a table of noisy samples is driven as is: {other:?}"),
+    }
+    let recorded = Family {
+        profile: palc_user::LateralProfile::Recorded(palc_user::RecordedProfile::new(
+            noisy_samples(),
+            0.05,
+        )),
+        ..Family::default()
+    };
+    let user = SimulatedUser::new("recorded", style, recorded, 0.3, None).unwrap();
+    let expectation = user.nominal(&scene).unwrap();
+    let (acceleration, _) = expectation.lane_change.peak_acceleration_and_jerk();
+    // The quintic's own peak is 5.77 × 3.5 m / (3 s)² = 2.24 m/s².
+    assert!(acceleration < 4.0, "{acceleration}");
+}
