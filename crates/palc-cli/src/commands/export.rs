@@ -10,8 +10,10 @@
 //! and `y = l` on the straight road (from the ego's front bumper at the trigger),
 //! positions moved from palc's front bumpers to vehicle centres, the steering
 //! angle from the path's curvature with the BMW 320i's wheelbase (CommonRoad's
-//! vehicle type 2). The goal is the target lane from the end of the standard
-//! ALC's lane change to the end of the plan. `--grid` does the same for every
+//! vehicle type 2). The trajectory is the lane change and one second more
+//! ([`AFTER_SETTLED_S`]): past it palc's ACC drives, not the plan. The goal is
+//! the target lane from the earlier of the standard ALC's end and the learned
+//! lane change's to the end of the trajectory. `--grid` does the same for every
 //! cell of the config's test bed (its seed) and each of the paper's three styles.
 
 use std::path::{Path, PathBuf};
@@ -67,6 +69,11 @@ const OBSTACLE_ID_OFFSET: u32 = 100;
 const PLANNING_PROBLEM_ID: u32 = 10;
 /// Road ahead of and behind every vehicle of the scenario (m).
 const ROAD_MARGIN_M: f64 = 20.0;
+/// How long the exported trajectory goes on once the lane change has settled
+/// (s). Past the lane change palc's ACC drives the ego; the plan's tail keeps
+/// the planned speed and would run into a slower target-lane leader that the
+/// ACC follows, so it is not what palc drives.
+const AFTER_SETTLED_S: f64 = 1.0;
 
 /// Runs `palc export`.
 pub fn run(args: ExportArgs) -> anyhow::Result<()> {
@@ -134,15 +141,22 @@ fn export_one(config: &LearnConfig, id: &str, out: &Path) -> anyhow::Result<Stri
             break outcome;
         }
     };
-    let plan = run.next_plan().clone();
+    let mut plan = run.next_plan().clone();
     let takeovers = run
         .records()
         .iter()
         .filter(|r| r.takeover.is_some())
         .count();
+    let dt = setup.dt;
+    // The lane change and AFTER_SETTLED_S more: from the step after which the ego
+    // stays within SETTLED_M of the target lane's centre.
+    let settled = (plan.states.iter())
+        .rposition(|x| (x.l - setup.target_l).abs() > palc_harness::user::SETTLED_M)
+        .map_or(0, |last_off| last_off + 1);
+    let keep = settled + (AFTER_SETTLED_S / dt).round() as usize + 1;
+    plan.states.truncate(keep.max(2));
     let states = &plan.states;
     let horizon = states.len().saturating_sub(1);
-    let dt = setup.dt;
     let ego = setup.scene.ego().context("the scene has no ego")?;
     let ego_length = ego.length;
 
@@ -268,7 +282,7 @@ fn export_one(config: &LearnConfig, id: &str, out: &Path) -> anyhow::Result<Stri
                 slip_angle: 0.0,
             },
             goal: GoalRegion {
-                time_start: u32::try_from(standard_end.min(horizon))?,
+                time_start: u32::try_from(standard_end.min(settled).min(horizon))?,
                 time_end: u32::try_from(horizon)?,
             },
         },
