@@ -451,6 +451,13 @@ fn the_file_round_trips_and_validates() {
         matches!(&e, ReadError::Invalid { field, .. } if field == "version"),
         "{e}"
     );
+    // A later version is named as such, not by a field it lacks.
+    let e =
+        write_and_read("{\"format\": \"palc-recorded-lane-changes\", \"version\": 2}".to_owned());
+    assert!(
+        matches!(&e, ReadError::Invalid { field, .. } if field == "version"),
+        "{e}"
+    );
     let e = write_and_read(json.replacen("\"merge\": false", "\"merge\": false, \"extra\": 1", 1));
     assert!(matches!(e, ReadError::Json { .. }), "{e}");
 

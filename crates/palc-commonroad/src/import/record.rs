@@ -86,6 +86,36 @@ pub struct StartContext {
     pub target_lag: Option<Neighbour>,
 }
 
+/// The fields that say what a file is.
+#[derive(Deserialize)]
+struct Header {
+    #[serde(default)]
+    format: String,
+    #[serde(default)]
+    version: u32,
+}
+
+/// `Ok` for [`FORMAT`] version [`VERSION`], else the error naming the field.
+fn check_header(format: &str, version: u32, path: &Path) -> Result<(), ReadError> {
+    if format != FORMAT {
+        return Err(ReadError::Invalid {
+            path: path.to_owned(),
+            field: "format".to_owned(),
+            value: format!("{format:?}"),
+            bound: format!("\"{FORMAT}\" (a file written by `palc import commonroad`)"),
+        });
+    }
+    if version != VERSION {
+        return Err(ReadError::Invalid {
+            path: path.to_owned(),
+            field: "version".to_owned(),
+            value: version.to_string(),
+            bound: format!("{VERSION}, the version this palc reads (import the scenarios again)"),
+        });
+    }
+    Ok(())
+}
+
 /// One lane change of a recorded vehicle.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -279,12 +309,17 @@ impl RecordedLaneChanges {
             path: path.to_owned(),
             error,
         })?;
-        let file: Self = serde_json::from_str(&text).map_err(|e| ReadError::Json {
+        let json_error = |e: serde_json::Error| ReadError::Json {
             path: path.to_owned(),
             line: e.line(),
             column: e.column(),
             message: e.to_string(),
-        })?;
+        };
+        // The format and version first, so that another file or version is named
+        // as such rather than by the first field it lacks.
+        let header: Header = serde_json::from_str(&text).map_err(json_error)?;
+        check_header(&header.format, header.version, path)?;
+        let file: Self = serde_json::from_str(&text).map_err(json_error)?;
         file.validate(path)?;
         Ok(file)
     }
