@@ -232,6 +232,27 @@ fn plan_with(dir: &Path, from: &str, to: &str) -> Output {
 }
 
 #[test]
+fn a_refused_plan_input_leaves_the_previous_output_untouched() {
+    let dir = scratch("plan-untouched");
+    let output = plan_with(&dir, "\"phi\": 0.0", "\"phi\": 0.0");
+    succeeds(&output);
+    let before = std::fs::read(dir.join("out.json")).unwrap();
+    assert!(String::from_utf8_lossy(&before).contains("\"solved\""));
+    let text = read("configs/examples/plan-problem.json");
+    // Negative weights: the planner refuses them as non-convex.
+    let weights = text.find("\"weights\"").unwrap();
+    let (head, tail) = text.split_at(weights);
+    let tail = tail.replacen("0.01", "-50.0", 1);
+    std::fs::write(dir.join("p.json"), format!("{head}{tail}")).unwrap();
+    let output = palc(&["plan", "--problem", "p.json", "--out", "out.json"], &dir);
+    assert!(!output.status.success(), "{output:?}");
+    assert_eq!(std::fs::read(dir.join("out.json")).unwrap(), before);
+    let output = plan_with(&dir, "\"v\": 20.1168", "\"v\": -20.1168");
+    fails_with(&output, &["initial.v"]);
+    assert_eq!(std::fs::read(dir.join("out.json")).unwrap(), before);
+}
+
+#[test]
 fn plan_refuses_unknown_keys_negative_speeds_and_huge_horizons() {
     let dir = scratch("plan");
     let output = plan_with(&dir, "\"phi\": 0.0", "\"phi\": 0.0, \"psi\": 1.0");

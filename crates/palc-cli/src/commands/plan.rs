@@ -22,7 +22,9 @@
 //! `learned_cost` (w · Φ), `extras` `{acceleration, tracking, lateral_slack}`,
 //! `features` (K arrays of 10, Eq. 34), `lateral_violation` (K+1), `stats`
 //! `{status, iterations, build_seconds, solve_seconds, structure_reused}`; on refusal
-//! `message`. A refusal also exits with an error after writing the output.
+//! `message`. A refusal exits with an error: one of the problem (`infeasible`,
+//! `unbounded`, `solver_failed`) after writing the output, one of the input
+//! (`invalid_input`, `non_convex` weights) on stderr alone, with `--out` untouched.
 
 use std::{fs::File, io::BufReader, path::PathBuf};
 
@@ -99,6 +101,12 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
             plan: None,
         },
     };
+    if let Err(error) = &result {
+        if matches!(output.status, "invalid_input" | "non_convex") {
+            // An input that cannot be planned is not an outcome: no file is touched.
+            bail!("{}: {error}", path.display());
+        }
+    }
     let mut bytes = serde_json::to_vec_pretty(&output)?;
     bytes.push(b'\n');
     match &args.out {
