@@ -223,6 +223,8 @@ impl Experience {
 
     /// Parses the bytes of an experience file; `path` only names it in errors.
     fn from_json(bytes: &[u8], path: &Path) -> Result<Self, AggregatorError> {
+        // A UTF-8 byte-order mark (some editors write one) is not part of the JSON.
+        let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
         let corrupt = |reason: String| AggregatorError::Corrupt {
             path: path.to_path_buf(),
             reason,

@@ -111,6 +111,20 @@ proptest! {
 }
 
 #[test]
+fn an_experience_with_a_byte_order_mark_loads_as_without() {
+    let dir = scratch();
+    let path = dir.join("experience.json");
+    let experience = sample_experience();
+    experience.save(&path).unwrap();
+    let mut bytes = b"\xEF\xBB\xBF".to_vec();
+    bytes.extend(fs::read(&path).unwrap());
+    let marked = dir.join("marked.json");
+    fs::write(&marked, bytes).unwrap();
+    assert_eq!(Experience::load(&marked).unwrap(), experience);
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
 fn save_replaces_the_file_and_leaves_no_temporary_file() {
     let dir = scratch();
     let path = dir.join("experience.json");

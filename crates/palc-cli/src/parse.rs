@@ -47,6 +47,9 @@ where
     }
 }
 
+/// The UTF-8 byte-order mark some editors write at the start of a file.
+const BYTE_ORDER_MARK: &[u8] = b"\xEF\xBB\xBF";
+
 /// Parses a TOML document.
 pub fn toml<T: DeserializeOwned>(text: &str) -> Result<T, ParseError> {
     let deserializer = toml::de::Deserializer::parse(text).map_err(|source| ParseError {
@@ -57,8 +60,15 @@ pub fn toml<T: DeserializeOwned>(text: &str) -> Result<T, ParseError> {
         .map_err(|e| error(&e.path().clone(), e.into_inner()))
 }
 
-/// Parses one JSON value; anything but whitespace after it is an error.
+/// Parses one JSON value; anything but whitespace after it is an error. A UTF-8
+/// byte-order mark at the start is skipped, as the TOML and CSV readers do.
 pub fn json<T: DeserializeOwned>(reader: impl Read) -> Result<T, ParseError> {
+    let mut reader = std::io::BufReader::new(reader);
+    if let Ok(start) = std::io::BufRead::fill_buf(&mut reader) {
+        if start.starts_with(BYTE_ORDER_MARK) {
+            std::io::BufRead::consume(&mut reader, BYTE_ORDER_MARK.len());
+        }
+    }
     let mut deserializer = serde_json::Deserializer::from_reader(reader);
     let value = serde_path_to_error::deserialize(&mut deserializer)
         .map_err(|e| error(&e.path().clone(), e.into_inner()))?;
@@ -89,6 +99,14 @@ mod tests {
             message.contains("`problem.initial.v`: invalid type") && message.contains("line 19"),
             "{message}"
         );
+    }
+
+    #[test]
+    fn a_byte_order_mark_before_the_json_is_skipped() {
+        let marked = [b"\xEF\xBB\xBF".as_slice(), PLAN.as_bytes()].concat();
+        let input = json::<PlanInput>(marked.as_slice()).unwrap();
+        let plain = json::<PlanInput>(PLAN.as_bytes()).unwrap();
+        assert_eq!(format!("{input:?}"), format!("{plain:?}"));
     }
 
     #[test]

@@ -451,6 +451,9 @@ fn the_file_round_trips_and_validates() {
         matches!(&e, ReadError::Invalid { field, .. } if field == "version"),
         "{e}"
     );
+    // A byte-order mark is skipped.
+    std::fs::write(&path, format!("\u{feff}{json}")).unwrap();
+    assert_eq!(RecordedLaneChanges::read(&path).unwrap(), file);
     // A later version is named as such, not by a field it lacks.
     let e =
         write_and_read("{\"format\": \"palc-recorded-lane-changes\", \"version\": 2}".to_owned());

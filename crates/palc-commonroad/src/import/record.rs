@@ -309,6 +309,8 @@ impl RecordedLaneChanges {
             path: path.to_owned(),
             error,
         })?;
+        // A UTF-8 byte-order mark (some editors write one) is not part of the JSON.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(&text);
         let json_error = |e: serde_json::Error| ReadError::Json {
             path: path.to_owned(),
             line: e.line(),
@@ -317,9 +319,9 @@ impl RecordedLaneChanges {
         };
         // The format and version first, so that another file or version is named
         // as such rather than by the first field it lacks.
-        let header: Header = serde_json::from_str(&text).map_err(json_error)?;
+        let header: Header = serde_json::from_str(text).map_err(json_error)?;
         check_header(&header.format, header.version, path)?;
-        let file: Self = serde_json::from_str(&text).map_err(json_error)?;
+        let file: Self = serde_json::from_str(text).map_err(json_error)?;
         file.validate(path)?;
         Ok(file)
     }
