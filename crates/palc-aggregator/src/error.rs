@@ -58,6 +58,16 @@ pub enum AggregatorError {
         /// The value.
         value: f64,
     },
+    /// A stored value lies outside its bound.
+    #[error("`{field}` is {value:?}, expected {bound}")]
+    OutOfRange {
+        /// The field with its index, e.g. `demonstration[12]`.
+        field: String,
+        /// The value.
+        value: f64,
+        /// The bound, in words.
+        bound: String,
+    },
     /// A weight matrix cannot be resampled to the requested horizon or step.
     #[error("cannot resample weights: {reason}")]
     Resample {

@@ -11,6 +11,14 @@ use crate::{AggregatorError, ApprenticeshipState, Onset, resample_weights};
 
 /// The experience format version this build writes and the newest it reads.
 pub const EXPERIENCE_FORMAT_VERSION: u32 = 1;
+/// Bounds of an experience's step `metadata.dt` (s): the harness plans at most at
+/// 0.5 s (`planning.dt`), and a millisecond step resamples a 60 s plan into
+/// 60,000 columns, beyond the planner's horizon.
+pub const EXPERIENCE_DT_BOUNDS_S: (f64, f64) = (1e-3, 0.5);
+/// Largest lateral offset (m) a stored demonstration may hold: four lanes of
+/// 3.75 m either side of the ego's. The scene's own road is checked when the
+/// experience is carried into it (palc-harness).
+pub const MAX_DEMONSTRATION_OFFSET_M: f64 = 15.0;
 
 /// Who and what an experience belongs to.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -87,7 +95,9 @@ impl Experience {
     ///
     /// # Errors
     /// [`AggregatorError::Resample`] for `dt` not finite and positive or an empty
-    /// weight matrix, [`AggregatorError::NonFinite`] for a non-finite weight.
+    /// weight matrix, [`AggregatorError::NonFinite`] for a non-finite weight,
+    /// [`AggregatorError::OutOfRange`] for a step outside [`EXPERIENCE_DT_BOUNDS_S`]
+    /// or more columns than [`palc_planner::MAX_HORIZON`].
     pub fn new(
         user_id: impl Into<String>,
         scenario: impl Into<String>,
@@ -121,18 +131,46 @@ impl Experience {
         resample_weights(&self.weights, self.metadata.dt, horizon, dt)
     }
 
-    /// Checks the invariants a stored experience must satisfy.
+    /// Checks the invariants a stored experience must satisfy: the step in
+    /// [`EXPERIENCE_DT_BOUNDS_S`], at most [`palc_planner::MAX_HORIZON`] weight
+    /// columns, finite numbers, the anchor inside the weights' time base, the
+    /// demonstration no longer than the weights and within
+    /// [`MAX_DEMONSTRATION_OFFSET_M`], the onsets in their ranges.
     pub fn validate(&self) -> Result<(), AggregatorError> {
+        let out_of_range = |field: String, value: f64, bound: String| AggregatorError::OutOfRange {
+            field,
+            value,
+            bound,
+        };
         let dt = self.metadata.dt;
         if !(dt.is_finite() && dt > 0.0) {
             return Err(AggregatorError::Resample {
                 reason: format!("metadata.dt = {dt} s must be finite and > 0"),
             });
         }
-        if self.weights.horizon() == 0 {
+        let (dt_low, dt_high) = EXPERIENCE_DT_BOUNDS_S;
+        if !(dt_low..=dt_high).contains(&dt) {
+            return Err(out_of_range(
+                "metadata.dt".into(),
+                dt,
+                format!("a step in [{dt_low}, {dt_high}] s"),
+            ));
+        }
+        let horizon = self.weights.horizon();
+        if horizon == 0 {
             return Err(AggregatorError::Resample {
                 reason: "the weight matrix has no column".into(),
             });
+        }
+        if horizon > palc_planner::MAX_HORIZON {
+            return Err(out_of_range(
+                "weights".into(),
+                horizon as f64,
+                format!(
+                    "at most {} columns (the planner's horizon)",
+                    palc_planner::MAX_HORIZON
+                ),
+            ));
         }
         if let Some(anchor) = self.anchor_s {
             if !anchor.is_finite() {
@@ -140,6 +178,35 @@ impl Experience {
                     field: "anchor_s".into(),
                     value: anchor,
                 });
+            }
+            let end = horizon as f64 * dt;
+            if !(0.0..=end).contains(&anchor) {
+                return Err(out_of_range(
+                    "anchor_s".into(),
+                    anchor,
+                    format!("a time in the weights' time base, [0, {end}] s"),
+                ));
+            }
+        }
+        if let Some(path) = &self.demonstration {
+            if path.len() > horizon + 1 {
+                return Err(out_of_range(
+                    "demonstration".into(),
+                    path.len() as f64,
+                    format!(
+                        "at most {} steps (the weights' horizon plus one)",
+                        horizon + 1
+                    ),
+                ));
+            }
+            for (i, &l) in path.iter().enumerate() {
+                if l.is_finite() && l.abs() > MAX_DEMONSTRATION_OFFSET_M {
+                    return Err(out_of_range(
+                        format!("demonstration[{i}]"),
+                        l,
+                        format!("a lateral offset within ±{MAX_DEMONSTRATION_OFFSET_M} m"),
+                    ));
+                }
             }
         }
         for (i, onset) in self.onsets.iter().enumerate() {
@@ -252,6 +319,10 @@ impl Experience {
             demonstration: stored.demonstration,
         };
         experience.validate().map_err(|e| corrupt(e.to_string()))?;
+        // A file steers the planner: its weights must pass the planner's own
+        // convexity check, as `palc plan` requires of the weights it is given.
+        palc_planner::check_convexity(&experience.weights)
+            .map_err(|e| corrupt(format!("its weights: {e}")))?;
         Ok(experience)
     }
 }

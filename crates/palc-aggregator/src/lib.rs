@@ -97,7 +97,10 @@ pub use correction::{
     IncrementalRule, RewardCorrection, TargetRule,
 };
 pub use error::AggregatorError;
-pub use experience::{EXPERIENCE_FORMAT_VERSION, Experience, ExperienceMetadata};
+pub use experience::{
+    EXPERIENCE_DT_BOUNDS_S, EXPERIENCE_FORMAT_VERSION, Experience, ExperienceMetadata,
+    MAX_DEMONSTRATION_OFFSET_M,
+};
 pub use expert::{ExpertGenerator, ExpertInput, ExpertKind, LessonExpert, ZoneCentreExpert};
 pub use lesson::Lesson;
 pub use onset::Onset;

@@ -8,9 +8,10 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use palc_aggregator::{
-    AggregatorError, ApprenticeshipState, EXPERIENCE_FORMAT_VERSION, Experience, Onset,
+    AggregatorError, ApprenticeshipState, EXPERIENCE_DT_BOUNDS_S, EXPERIENCE_FORMAT_VERSION,
+    Experience, MAX_DEMONSTRATION_OFFSET_M, Onset,
 };
-use palc_planner::{FEATURE_COUNT, Features, Weights};
+use palc_planner::{FEATURE_COUNT, Features, Weights, feature};
 use palc_zone_filter::{Label, Sample, ZoneConfig, ZoneModel};
 use proptest::prelude::*;
 
@@ -32,7 +33,7 @@ fn sample_experience() -> Experience {
         "user-7",
         "45-40mph-40m",
         "palc",
-        Weights::constant(20, common::STANDARD),
+        Weights::constant(60, common::STANDARD),
         0.1,
     )
     .unwrap();
@@ -77,14 +78,35 @@ fn finite() -> impl Strategy<Value = f64> {
     any::<f64>().prop_filter("finite", |x| x.is_finite())
 }
 
+/// A weight column a file may hold: any finite values on the rows that do not
+/// affect convexity, any non-negative ones on the diagonals, no coupling to δ, so
+/// that every stage passes `check_convexity` (a file must).
+fn convex_column() -> impl Strategy<Value = [f64; 10]> {
+    prop::array::uniform10(finite()).prop_map(|mut w| {
+        for j in [feature::L_DELTA, feature::PHI_DELTA, feature::S_DELTA] {
+            w[j] = 0.0;
+        }
+        for j in [
+            feature::L_SQUARED,
+            feature::PHI_SQUARED,
+            feature::DELTA_SQUARED,
+            feature::DIST_PRECEDING,
+            feature::DIST_ADJACENT,
+        ] {
+            w[j] = w[j].abs();
+        }
+        w
+    })
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
     #[test]
     fn save_then_load_is_bit_exact(
-        columns in prop::collection::vec(prop::array::uniform10(finite()), 1..40),
+        columns in prop::collection::vec(convex_column(), 1..40),
         mu in prop::collection::vec(prop::array::uniform10(finite()), 1..5),
-        dt in 1e-4f64..1.0,
+        dt in EXPERIENCE_DT_BOUNDS_S.0..=EXPERIENCE_DT_BOUNDS_S.1,
         lessons in any::<u64>(),
         user in "[a-zA-Z0-9 _\\-\u{e9}\u{4e2d}]{0,16}",
         with_zone in any::<bool>(),
@@ -279,6 +301,89 @@ fn a_non_finite_onset_is_refused_naming_it() {
     assert!(message.contains("onsets[0].gap_m"), "{message}");
 }
 
+/// Each value a file may not hold is refused on load, naming the field, the
+/// value and its bound; the file is left as it was.
+#[test]
+fn values_out_of_their_bounds_are_refused_naming_field_value_and_bound() {
+    let dir = scratch();
+    let path = dir.join("experience.json");
+    let cases: [(&str, fn(&mut Experience), &str, &str); 6] = [
+        (
+            "a step of 1 s",
+            |e| e.metadata.dt = 1.0,
+            "metadata.dt",
+            "0.5",
+        ),
+        (
+            "a step of 0.1 ms",
+            |e| e.metadata.dt = 1e-4,
+            "metadata.dt",
+            "0.001",
+        ),
+        (
+            "an anchor before the plan",
+            |e| e.anchor_s = Some(-0.5),
+            "anchor_s",
+            "[0, 6",
+        ),
+        (
+            "an anchor after the weights",
+            |e| e.anchor_s = Some(60.0),
+            "anchor_s",
+            "[0, 6",
+        ),
+        (
+            "a demonstration longer than the weights",
+            |e| e.demonstration = Some(vec![0.0; 62]),
+            "demonstration",
+            "61 steps",
+        ),
+        (
+            "a demonstration 40 m away",
+            |e| e.demonstration.as_mut().unwrap()[7] = 40.0,
+            "demonstration[7]",
+            "15 m",
+        ),
+    ];
+    for (what, spoil, field, bound) in cases {
+        let mut experience = sample_experience();
+        spoil(&mut experience);
+        // `save` validates too, so the file is written from a serialized copy.
+        let message = experience.validate().unwrap_err().to_string();
+        assert!(
+            message.contains(field) && message.contains(bound),
+            "{what}: {message}"
+        );
+        assert!(experience.save(&path).is_err(), "{what}: saved");
+    }
+    assert!(MAX_DEMONSTRATION_OFFSET_M > 3.75 * 2.0);
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A file whose weights would make the planner's cost non-convex is refused on
+/// load, as `palc plan` refuses such weights.
+#[test]
+fn non_convex_weights_in_a_file_are_refused_on_load() {
+    let dir = scratch();
+    let path = dir.join("experience.json");
+    sample_experience().save(&path).unwrap();
+    let mut value: serde_json::Value =
+        serde_json::from_str(&fs::read_to_string(&path).unwrap()).unwrap();
+    // w5 (l·δ) coupled to a zero l² diagonal in the first column.
+    let column = &mut value["weights"][0];
+    column[feature::L_SQUARED] = 0.0.into();
+    column[feature::DIST_PRECEDING] = 0.0.into();
+    column[feature::DIST_ADJACENT] = 0.0.into();
+    column[feature::L_DELTA] = 1.0.into();
+    let edited = serde_json::to_string_pretty(&value).unwrap();
+    fs::write(&path, &edited).unwrap();
+    let err = Experience::load(&path).unwrap_err();
+    assert!(matches!(err, AggregatorError::Corrupt { .. }), "{err}");
+    assert!(err.to_string().contains("non-convex"), "{err}");
+    assert_eq!(fs::read_to_string(&path).unwrap(), edited);
+    fs::remove_dir_all(&dir).unwrap();
+}
+
 #[test]
 fn missing_file_is_an_io_error_naming_it() {
     let dir = scratch();
@@ -290,7 +395,7 @@ fn missing_file_is_an_io_error_naming_it() {
 
 #[test]
 fn weights_are_usable_at_another_horizon_and_step() {
-    let experience = sample_experience(); // K = 20 at 0.1 s
+    let experience = sample_experience(); // K = 60 at 0.1 s
     let w = experience.weights_for(40, 0.05).unwrap();
     assert_eq!(w.horizon(), 40);
     assert!(palc_planner::check_convexity(&w).is_ok());

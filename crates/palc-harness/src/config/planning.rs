@@ -90,8 +90,15 @@ impl PlanningConfig {
                 return Err(invalid(field, value, "a finite value > 0"));
             }
         }
-        if self.dt > 0.5 {
-            return Err(invalid("planning.dt", self.dt, "at most 0.5 s"));
+        // The step an experience may be stored at: a plan at another step could
+        // not be saved or carried.
+        let (dt_low, dt_high) = palc_aggregator::EXPERIENCE_DT_BOUNDS_S;
+        if !(dt_low..=dt_high).contains(&self.dt) {
+            return Err(invalid(
+                "planning.dt",
+                self.dt,
+                &format!("a step in [{dt_low}, {dt_high}] s"),
+            ));
         }
         if !(self.standard_alc_min_delay_s.is_finite() && self.standard_alc_min_delay_s >= 0.0) {
             return Err(invalid(
