@@ -53,6 +53,8 @@ fn family() -> impl Strategy<Value = Family> {
         Just(StartRule::TimeHeadway),
         (4.0f64..12.0).prop_map(|seconds| StartRule::TimeToCollision { seconds }),
         (15.0f64..40.0).prop_map(|metres| StartRule::DistanceGap { metres }),
+        (0.0f64..0.5).prop_map(|threshold_mps2| StartRule::Incentive { threshold_mps2 }),
+        (4.0f64..12.0).prop_map(|ttc_seconds| StartRule::HeadwayOrTtc { ttc_seconds }),
     ];
     let speed = prop_oneof![
         Just(SpeedRule::Constant),
@@ -100,11 +102,20 @@ fn check(expectation: &Expectation, setup: &Setup, family: &Family, style: &Styl
     assert!(jerk <= MAX_LATERAL_JERK_MPS3);
     // The start rule holds at the decision, the start is no earlier than the
     // reaction, and nothing moves before the start.
+    let scene_set_speed = setup.user_scene().set_speed;
     let decided = &setup.situations[expectation.decision_step];
-    assert!(family.start.decides(decided, style.time_headway_s));
+    assert!(
+        family
+            .start
+            .decides(decided, style.time_headway_s, scene_set_speed)
+    );
     if expectation.decision_step > 0 {
         let before = &setup.situations[expectation.decision_step - 1];
-        assert!(!family.start.decides(before, style.time_headway_s));
+        assert!(
+            !family
+                .start
+                .decides(before, style.time_headway_s, scene_set_speed)
+        );
     }
     let reaction_steps = (family.reaction_s / dt - 1e-9).ceil() as usize;
     assert!(expectation.start_step >= expectation.decision_step + reaction_steps);
@@ -174,6 +185,10 @@ fn most_plausible_families_are_accepted_in_the_grid() {
             ..Family::default()
         },
         Family {
+            start: StartRule::HeadwayOrTtc { ttc_seconds: 8.0 },
+            ..Family::default()
+        },
+        Family {
             profile: LateralProfile::Cosine,
             reaction_s: 0.8,
             ..Family::default()
@@ -219,6 +234,14 @@ fn invalid_user_tables_name_the_field_value_and_bound() {
         (
             "[user]\nstyle = \"neutral\"\nfamily = { reaction_s = -1.0 }",
             "user.family.reaction_s",
+        ),
+        (
+            "[user]\nstyle = \"neutral\"\nfamily = { start = { rule = \"incentive\", threshold_mps2 = 3.0 } }",
+            "user.family.start.threshold_mps2",
+        ),
+        (
+            "[user]\nstyle = \"neutral\"\nfamily = { start = { rule = \"headway-or-ttc\", ttc_seconds = 0.5 } }",
+            "user.family.start.ttc_seconds",
         ),
         (
             "[user]\nstyle = \"neutral\"\nspread = { relative = 0.0, seed = 1, parameters = { reaction_s = { absolute = -0.1 } } }",
@@ -303,4 +326,39 @@ fn a_user_from_outside_the_harness_plugs_into_the_loop() {
         .unwrap();
     assert!(result.summary.counted_takeovers() > 0);
     assert!(result.records.iter().any(|r| r.takeover.is_some()));
+}
+
+#[test]
+fn an_incentive_driver_changes_only_where_the_target_lane_gains() {
+    // MOBIL's driver (threshold 0.1 m/s², Kesting et al. 2007) in the test bed,
+    // whose target lane moves at the preceding vehicle's speed: on the collector
+    // cells the target lane's leader is far enough ahead to gain acceleration once
+    // the follower has passed, on arterial-high at 50 m it never is before the
+    // ego has closed in (the target lane's leaders are nearer than the own one).
+    let family = Family {
+        start: StartRule::Incentive {
+            threshold_mps2: 0.1,
+        },
+        ..Family::default()
+    };
+    let user = SimulatedUser::new("probe", Style::NEUTRAL, family.clone(), 0.3, None).unwrap();
+    for case in ["collector-high", "collector-slow"] {
+        let setup = setup(case, 50.0);
+        let expectation = user.nominal(&setup.user_scene()).unwrap();
+        check(&expectation, &setup, &family, &Style::NEUTRAL);
+        let decided = &setup.situations[expectation.decision_step];
+        let (gain, follower) = palc_user::incentive_mps2(decided, setup.user_scene().set_speed);
+        assert!(gain > 0.1 && follower >= -palc_user::INCENTIVE_SAFE_DECELERATION_MPS2);
+    }
+    let refused = user.nominal(&setup("arterial-high", 50.0).user_scene());
+    assert!(
+        matches!(
+            refused,
+            Err(UserError::Refused {
+                refusal: palc_user::UserRefusal::StartRuleNeverMet { .. },
+                ..
+            })
+        ),
+        "{refused:?}"
+    );
 }

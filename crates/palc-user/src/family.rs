@@ -7,6 +7,7 @@
 //! `[user.family]` table changes nothing. docs/experiments/0036-user-families.md
 //! says why each rule is plausible for a human driver.
 
+use palc_traffic::IdmParams;
 use serde::{Deserialize, Serialize};
 
 use crate::UserError;
@@ -35,8 +36,21 @@ pub const SETTLED_M: f64 = 0.05;
 /// Bounds of the lateral offset from which a user judges the target lane's gaps (m).
 pub const ONSET_BOUNDS_M: (f64, f64) = (0.05, 3.0);
 
+/// Bounds of the incentive start threshold (m/s²): MOBIL's switching threshold
+/// `Δa_th` is 0.1 m/s² for cars (Kesting, Treiber and Helbing, 2007, Table 1); a
+/// driver who needs 2 m/s² of advantage hardly ever changes lanes.
+pub const INCENTIVE_START_BOUNDS_MPS2: (f64, f64) = (0.0, 2.0);
+/// The target lane's follower may be made to brake at most this hard (m/s²) by an
+/// incentive-based start: MOBIL's safety criterion `b_safe` (Kesting et al., 2007,
+/// Table 1: 4 m/s²), below the physical limit of about 9 m/s².
+pub const INCENTIVE_SAFE_DECELERATION_MPS2: f64 = 4.0;
+
 /// When a user decides to change lanes; gap acceptance on the target lane and
 /// the reaction time come after the decision.
+///
+/// The first three rules are thresholds on one cue of the vehicle ahead; the last
+/// two are the driver-modelling literature's decisions that are not: a speed
+/// gain weighed against the target lane (MOBIL), and several cues at once.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
 #[serde(tag = "rule", rename_all = "kebab-case", deny_unknown_fields)]
 pub enum StartRule {
@@ -54,6 +68,26 @@ pub enum StartRule {
         /// Threshold (m), in [`DISTANCE_START_BOUNDS_M`].
         metres: f64,
     },
+    /// The speed-gain incentive of MOBIL (Kesting, Treiber and Helbing, 2007,
+    /// Eqs. 4-5) with politeness 0, the speed-gain motive of SUMO's LC2013: the
+    /// ego's IDM acceleration behind the target lane's leader (or on a free road)
+    /// exceeds its acceleration behind the preceding vehicle by `threshold_mps2`,
+    /// and the target lane's follower behind the ego would brake less than
+    /// [`INCENTIVE_SAFE_DECELERATION_MPS2`]. The driver reasons with the IDM of
+    /// Treiber et al. (2000) at the ego's set speed, the model of the background
+    /// traffic ([`IdmParams::treiber_2000`]).
+    Incentive {
+        /// Switching threshold `Δa_th` (m/s²), in [`INCENTIVE_START_BOUNDS_MPS2`].
+        threshold_mps2: f64,
+    },
+    /// Two cues at once: the time headway has fallen to the style's
+    /// `time_headway_s` or the time to collision to `ttc_seconds`, whichever
+    /// comes first (a driver who reacts to closeness in slow traffic and to a
+    /// closing speed in fast traffic).
+    HeadwayOrTtc {
+        /// Time-to-collision threshold (s), in [`TTC_START_BOUNDS_S`].
+        ttc_seconds: f64,
+    },
 }
 
 impl StartRule {
@@ -63,17 +97,28 @@ impl StartRule {
             StartRule::TimeHeadway => "time-headway",
             StartRule::TimeToCollision { .. } => "time-to-collision",
             StartRule::DistanceGap { .. } => "distance-gap",
+            StartRule::Incentive { .. } => "incentive",
+            StartRule::HeadwayOrTtc { .. } => "headway-or-ttc",
         }
     }
 
     /// Whether the rule is met in `situation` for a style headway of
-    /// `time_headway_s`; never once the ego has reached the preceding vehicle.
-    pub fn decides(&self, situation: &Situation, time_headway_s: f64) -> bool {
+    /// `time_headway_s` and the ego's set speed `set_speed_mps` (the incentive's
+    /// desired speed); never once the ego has reached the preceding vehicle.
+    pub fn decides(&self, situation: &Situation, time_headway_s: f64, set_speed_mps: f64) -> bool {
         situation.time_headway_s > 0.0
             && match self {
                 StartRule::TimeHeadway => situation.time_headway_s <= time_headway_s,
                 StartRule::TimeToCollision { seconds } => situation.preceding_ttc_s() <= *seconds,
                 StartRule::DistanceGap { metres } => situation.preceding_gap_m <= *metres,
+                StartRule::Incentive { threshold_mps2 } => {
+                    let (gain, follower) = incentive_mps2(situation, set_speed_mps);
+                    gain > *threshold_mps2 && follower >= -INCENTIVE_SAFE_DECELERATION_MPS2
+                }
+                StartRule::HeadwayOrTtc { ttc_seconds } => {
+                    situation.time_headway_s <= time_headway_s
+                        || situation.preceding_ttc_s() <= *ttc_seconds
+                }
             }
     }
 
@@ -86,8 +131,45 @@ impl StartRule {
             StartRule::DistanceGap { metres } => {
                 within(&format!("{table}.metres"), metres, DISTANCE_START_BOUNDS_M)
             }
+            StartRule::Incentive { threshold_mps2 } => within(
+                &format!("{table}.threshold_mps2"),
+                threshold_mps2,
+                INCENTIVE_START_BOUNDS_MPS2,
+            ),
+            StartRule::HeadwayOrTtc { ttc_seconds } => within(
+                &format!("{table}.ttc_seconds"),
+                ttc_seconds,
+                TTC_START_BOUNDS_S,
+            ),
         }
     }
+}
+
+/// MOBIL's two accelerations in `situation` for an ego whose desired speed is
+/// `set_speed_mps` (Kesting et al., 2007, Eqs. 4-5): the ego's advantage
+/// `ã_c − a_c` (its IDM acceleration behind the target lane's leader, or on a
+/// free road, minus that behind the preceding vehicle), and `ã_n`, the IDM
+/// acceleration of the target lane's follower behind the ego after the change
+/// (0 without a follower; the IDM's hardest braking with the follower alongside).
+/// The follower's desired speed is its own speed or the ego's set speed,
+/// whichever is higher: a vehicle the driver cannot read is assumed content.
+pub fn incentive_mps2(situation: &Situation, set_speed_mps: f64) -> (f64, f64) {
+    let v = situation.ego_speed;
+    let ego = IdmParams::treiber_2000(set_speed_mps.max(v).max(1.0));
+    let here = (situation.preceding_speed)
+        .filter(|_| situation.preceding_gap_m.is_finite())
+        .map(|speed| (situation.preceding_gap_m, v - speed));
+    let there = situation.target_lead_gap_m.zip(situation.target_lead_speed);
+    let there = there.map(|(gap, speed)| (gap, v - speed));
+    let gain = ego.acceleration_behind(v, there) - ego.acceleration_behind(v, here);
+    let follower = match situation.target_lag_gap_m.zip(situation.target_lag_speed) {
+        Some((gap, speed)) => {
+            let params = IdmParams::treiber_2000(speed.max(set_speed_mps).max(1.0));
+            params.acceleration(speed, gap, speed - v)
+        }
+        None => 0.0,
+    };
+    (gain, follower)
 }
 
 /// The user's speed during its lane change.
@@ -282,15 +364,58 @@ mod tests {
     fn each_start_rule_reads_its_own_measure() {
         // 1.2 s headway at 20 m/s: a 24 m gap closing at 5 m/s, TTC 4.8 s.
         let s = seen(1.2, 50.0, 20.0);
-        assert!(StartRule::TimeHeadway.decides(&s, 1.23));
-        assert!(!StartRule::TimeHeadway.decides(&s, 1.1));
-        assert!(StartRule::TimeToCollision { seconds: 5.0 }.decides(&s, 0.0));
-        assert!(!StartRule::TimeToCollision { seconds: 4.5 }.decides(&s, 0.0));
-        assert!(StartRule::DistanceGap { metres: 25.0 }.decides(&s, 0.0));
-        assert!(!StartRule::DistanceGap { metres: 20.0 }.decides(&s, 0.0));
+        assert!(StartRule::TimeHeadway.decides(&s, 1.23, 25.0));
+        assert!(!StartRule::TimeHeadway.decides(&s, 1.1, 25.0));
+        assert!(StartRule::TimeToCollision { seconds: 5.0 }.decides(&s, 0.0, 25.0));
+        assert!(!StartRule::TimeToCollision { seconds: 4.5 }.decides(&s, 0.0, 25.0));
+        assert!(StartRule::DistanceGap { metres: 25.0 }.decides(&s, 0.0, 25.0));
+        assert!(!StartRule::DistanceGap { metres: 20.0 }.decides(&s, 0.0, 25.0));
+        // Either cue of two.
+        let either = StartRule::HeadwayOrTtc { ttc_seconds: 5.0 };
+        assert!(either.decides(&s, 1.1, 25.0));
+        assert!(either.decides(&s, 1.23, 25.0));
+        assert!(!StartRule::HeadwayOrTtc { ttc_seconds: 4.5 }.decides(&s, 1.1, 25.0));
         // Never behind a vehicle already reached.
         let reached = seen(-0.1, 50.0, 20.0);
-        assert!(!StartRule::DistanceGap { metres: 25.0 }.decides(&reached, 0.0));
+        assert!(!StartRule::DistanceGap { metres: 25.0 }.decides(&reached, 0.0, 25.0));
+    }
+
+    #[test]
+    fn the_incentive_weighs_the_target_lane_against_the_own_one() {
+        // 24 m behind a leader 5 m/s slower; the target lane's leader 50 m ahead
+        // at the ego's speed: changing gains acceleration.
+        let s = seen(1.2, 50.0, 20.0);
+        let (gain, follower) = incentive_mps2(&s, 25.0);
+        let ego = IdmParams::treiber_2000(25.0);
+        let expected = ego.acceleration(20.0, 50.0, 0.0) - ego.acceleration(20.0, 24.0, 5.0);
+        assert!((gain - expected).abs() < 1e-12 && gain > 0.5, "{gain}");
+        assert!(follower > -INCENTIVE_SAFE_DECELERATION_MPS2, "{follower}");
+        let rule = StartRule::Incentive {
+            threshold_mps2: 0.1,
+        };
+        assert!(rule.decides(&s, 0.0, 25.0));
+        // The same gain is refused with a follower that would brake beyond b_safe.
+        let tailgated = seen(1.2, 50.0, 1.0);
+        assert!(incentive_mps2(&tailgated, 25.0).1 < -INCENTIVE_SAFE_DECELERATION_MPS2);
+        assert!(!rule.decides(&tailgated, 0.0, 25.0));
+        // Far from a leader as fast as the ego, a slower target lane gains nothing.
+        let free = Situation {
+            time_headway_s: 5.0,
+            preceding_gap_m: 100.0,
+            preceding_speed: Some(20.0),
+            target_lead_speed: Some(15.0),
+            target_lead_gap_m: Some(20.0),
+            ..s
+        };
+        assert!(incentive_mps2(&free, 25.0).0 < 0.0);
+        assert!(!rule.decides(&free, 0.0, 25.0));
+        // Symmetry: the same vehicle ahead on both lanes gains exactly nothing.
+        let same = Situation {
+            target_lead_gap_m: Some(s.preceding_gap_m),
+            target_lead_speed: s.preceding_speed,
+            ..s
+        };
+        assert!(incentive_mps2(&same, 25.0).0.abs() < 1e-12);
     }
 
     #[test]

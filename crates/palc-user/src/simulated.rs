@@ -100,7 +100,11 @@ impl SimulatedUser {
         let window = scene.window();
         let decision_step = situations
             .iter()
-            .position(|s| family.start.decides(s, style.time_headway_s))
+            .position(|s| {
+                family
+                    .start
+                    .decides(s, style.time_headway_s, scene.set_speed)
+            })
             .ok_or_else(|| {
                 refuse(UserRefusal::StartRuleNeverMet {
                     rule: family.start.name().to_owned(),

@@ -9,7 +9,8 @@ use serde::{Deserialize, Serialize};
 use crate::UserError;
 use crate::family::{
     ACCELERATION_BOUNDS_MPS2, COMFORT_TIME_GAP_BOUNDS_S, COMFORT_TTC_BOUNDS_S,
-    DISTANCE_START_BOUNDS_M, Family, MAX_REACTION_S, SpeedRule, StartRule, TTC_START_BOUNDS_S,
+    DISTANCE_START_BOUNDS_M, Family, INCENTIVE_START_BOUNDS_MPS2, MAX_REACTION_S, SpeedRule,
+    StartRule, TTC_START_BOUNDS_S,
 };
 use crate::profile::{LateralProfile, PEAK_FRACTION_BOUNDS};
 use crate::style::{MAX_GAP_ACCEPTANCE_S, Style};
@@ -181,6 +182,14 @@ impl Spread {
                 }
                 StartRule::DistanceGap { metres } => {
                     *metres = d.apply(*metres, rng, DISTANCE_START_BOUNDS_M);
+                }
+                StartRule::Incentive { threshold_mps2 } => {
+                    *threshold_mps2 = d.apply(*threshold_mps2, rng, INCENTIVE_START_BOUNDS_MPS2);
+                }
+                StartRule::HeadwayOrTtc { ttc_seconds } => {
+                    // Both cues, headway first.
+                    style.time_headway_s = d.apply(style.time_headway_s, rng, (1e-3, 1e3));
+                    *ttc_seconds = d.apply(*ttc_seconds, rng, TTC_START_BOUNDS_S);
                 }
             }
         }
