@@ -14,9 +14,11 @@
 //! into the same directory (on Linux, where a process's liveness can be read from
 //! `/proc`).
 //!
-//! [`Staging`] is the same idea for a set of files: they are written into a
-//! temporary directory next to the destination, which is moved into place file by
-//! file at the end, so a failed run leaves the previous files as they were.
+//! [`Staging`] is the same idea for a directory of files: they are written into a
+//! temporary directory next to the destination, which takes the destination's
+//! place in one atomic exchange at the end (`renameat2` with `RENAME_EXCHANGE`,
+//! through `rustix`), so the destination holds either all of the previous files or
+//! all of the new ones.
 //!
 //! The temporary file itself comes from `tempfile` (unique name, removed on every
 //! error path); this module only adds what `tempfile` leaves to the caller.
@@ -215,51 +217,98 @@ fn remove_stale_temporaries(directory: &Path, file_name: &OsStr) {
 }
 
 /// A set of output files written into a temporary directory next to their
-/// destination and moved into place only by [`Staging::commit`]. Dropped without a
-/// commit (an error, a panic), it removes itself and the destination is untouched.
+/// destination, which takes the destination's place only in [`Staging::commit`].
+/// Dropped without a commit (an error, a panic), it removes itself and the
+/// destination is untouched.
 #[derive(Debug)]
 pub struct Staging {
     directory: tempfile::TempDir,
+    /// The destination as given.
     destination: PathBuf,
+    /// The destination with symbolic links followed: the directory replaced.
+    target: PathBuf,
 }
 
+/// A step of [`Staging::commit_with`] that changes the file system, announced
+/// before it is taken.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum CommitStep {
+    /// An entry of the previous destination that this run did not write (named
+    /// here) is hard-linked (a directory: its tree) into the staging directory;
+    /// the destination is not touched.
+    Carry(OsString),
+    /// The staging directory and the previous destination trade places in one
+    /// atomic exchange.
+    Exchange,
+    /// Where no exchange is offered: the previous destination is renamed aside.
+    MoveAside,
+    /// The staging directory is renamed to the destination (a destination that
+    /// did not exist, or after [`CommitStep::MoveAside`]).
+    MoveIn,
+    /// The previous results, no longer at the destination, are removed.
+    RemovePrevious,
+}
+
+/// The middle of the hidden name under which the fallback keeps the previous
+/// destination while the new one is renamed in.
+const PREVIOUS: &str = "previous";
+
 impl Staging {
-    /// Creates the staging directory next to `destination` (which need not exist),
-    /// after removing the staging directories of processes that have ended.
+    /// Creates the staging directory next to `destination` (which need not exist;
+    /// a symbolic link is followed), after putting back a previous destination that
+    /// a killed commit left aside and removing the staging directories of processes
+    /// that have ended.
     ///
     /// # Errors
-    /// [`OutputError`] naming `destination`.
+    /// [`OutputError`] naming `destination`, also when it exists and is not a
+    /// directory.
     pub fn new(destination: &Path) -> Result<Staging, OutputError> {
         let error = |error| OutputError {
             path: destination.to_owned(),
             error,
         };
-        let name = destination
-            .file_name()
-            .filter(|n| *n != "." && *n != "..")
-            .map(OsStr::to_owned)
-            .or_else(|| {
-                fs::canonicalize(destination)
-                    .ok()
-                    .and_then(|p| p.file_name().map(OsStr::to_owned))
-            })
-            .unwrap_or_else(|| OsString::from("out"));
-        let parent = match fs::canonicalize(destination) {
-            Ok(full) => parent_directory(&full),
-            Err(_) => parent_directory(destination),
-        };
+        let mut target = resolve_symlinks(destination).map_err(error)?;
+        match fs::metadata(&target) {
+            Ok(metadata) if !metadata.is_dir() => {
+                return Err(error(io::Error::new(
+                    io::ErrorKind::NotADirectory,
+                    "it exists and is not a directory",
+                )));
+            }
+            Ok(_) => {}
+            Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+            Err(e) => return Err(error(e)),
+        }
+        if target.file_name().is_none() {
+            // `.`, `..` or `/`: the directory's own name.
+            target = fs::canonicalize(&target).map_err(error)?;
+        }
+        let name = target.file_name().map(OsStr::to_owned).ok_or_else(|| {
+            error(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                "the path names no directory",
+            ))
+        })?;
+        let parent = parent_directory(&target);
         fs::create_dir_all(&parent).map_err(error)?;
+        restore_previous(&parent, &name, &target).map_err(error)?;
         remove_stale_temporaries(&parent, &name);
         let prefix = temporary_prefix(&name);
         let suffix = format!(".tmp-{}", std::process::id());
-        let directory = tempfile::Builder::new()
-            .prefix(&prefix)
-            .suffix(&suffix)
-            .tempdir_in(&parent)
-            .map_err(error)?;
+        let mut builder = tempfile::Builder::new();
+        builder.prefix(&prefix).suffix(&suffix);
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            // The mode `fs::create_dir` would give (0777 less the umask).
+            builder.permissions(fs::Permissions::from_mode(0o777));
+        }
+        let directory = builder.tempdir_in(&parent).map_err(error)?;
         Ok(Staging {
             directory,
             destination: destination.to_owned(),
+            target,
         })
     }
 
@@ -273,48 +322,204 @@ impl Staging {
         &self.destination
     }
 
-    /// Moves every file of the staging directory into the destination (created if
-    /// need be), each by one rename that replaces a file of the same name, the files
-    /// named in `last` after all others (e.g. a report after what it describes); then
-    /// removes the `obsolete` files of an earlier run that this one did not write, and
-    /// syncs the destination. Other files in the destination are left alone.
+    /// Puts the staging directory in the destination's place, as
+    /// [`Staging::commit_with`] does.
     ///
     /// # Errors
-    /// [`OutputError`] naming the file that could not be moved.
-    pub fn commit(self, last: &[&str], obsolete: &[&str]) -> Result<(), OutputError> {
-        let destination = self.destination.clone();
+    /// [`OutputError`] naming the path that could not be carried, moved or synced.
+    pub fn commit(self, obsolete: &[&str]) -> Result<(), OutputError> {
+        self.commit_with(obsolete, |_| Ok(()))
+    }
+
+    /// Puts the staging directory in the destination's place in one step, so that
+    /// the destination holds either all of its previous entries or all of the new
+    /// ones, whatever fails and whenever the process is killed.
+    ///
+    /// First the entries of the previous destination that this run did not write,
+    /// except the `obsolete` ones (files of an earlier run that this one no longer
+    /// makes), are hard-linked into the staging directory (a directory as a tree of
+    /// links, a file that cannot be linked copied), without touching the
+    /// destination: the user's own files and nested results stay. The staging
+    /// directory takes the previous destination's permissions and is synced. Then,
+    /// on Linux and macOS, one `renameat2(RENAME_EXCHANGE)` (macOS: `RENAME_SWAP`)
+    /// trades the two directories; the previous one, now at the staging name, is
+    /// removed. Where the system or the file system offers no exchange, the previous
+    /// destination is renamed aside, the staging directory renamed in and the
+    /// previous one removed: a kill between those two renames leaves no destination
+    /// but the previous one under a hidden name beside it, which the next
+    /// [`Staging::new`] for the same destination puts back. A destination that does
+    /// not exist is created by one rename.
+    ///
+    /// `before` is called before every step that changes the file system; an error
+    /// it returns stops the commit there as the failure of that step would (a test
+    /// hook: faults between every two steps; [`io::ErrorKind::Unsupported`] at
+    /// [`CommitStep::Exchange`] stands for a file system without the exchange). The
+    /// failure of [`CommitStep::RemovePrevious`] is no error: the results are in
+    /// place, and the next commit removes the leftover.
+    ///
+    /// # Errors
+    /// [`OutputError`] naming the path that could not be carried, moved or synced;
+    /// the destination then holds its previous entries.
+    pub fn commit_with(
+        self,
+        obsolete: &[&str],
+        mut before: impl FnMut(&CommitStep) -> io::Result<()>,
+    ) -> Result<(), OutputError> {
         let error = |path: &Path| {
             let path = path.to_owned();
             move |error| OutputError { path, error }
         };
-        fs::create_dir_all(&destination).map_err(error(&destination))?;
-        let mut entries: Vec<fs::DirEntry> = fs::read_dir(self.path())
-            .map_err(error(self.path()))?
-            .collect::<Result<_, _>>()
-            .map_err(error(self.path()))?;
-        entries.sort_by_key(fs::DirEntry::file_name);
-        let written: Vec<OsString> = entries.iter().map(fs::DirEntry::file_name).collect();
-        entries.sort_by_key(|e| last.iter().position(|l| e.file_name() == *l));
-        for entry in &entries {
-            let target = destination.join(entry.file_name());
-            fs::File::open(entry.path())
-                .and_then(|f| f.sync_all())
-                .map_err(error(&target))?;
-            fs::rename(entry.path(), &target).map_err(error(&target))?;
-        }
-        for name in obsolete {
-            if !written.iter().any(|w| w == name) {
-                let path = destination.join(name);
-                match fs::remove_file(&path) {
-                    Err(e) if e.kind() != io::ErrorKind::NotFound => {
-                        return Err(error(&path)(e));
-                    }
-                    _ => {}
-                }
+        let staged = self.directory.path().to_owned();
+        let target = self.target.clone();
+        let previous = match fs::metadata(&target) {
+            Ok(metadata) if metadata.is_dir() => Some(metadata),
+            Ok(_) => {
+                return Err(error(&self.destination)(io::Error::new(
+                    io::ErrorKind::NotADirectory,
+                    "it exists and is not a directory",
+                )));
             }
+            Err(e) if e.kind() == io::ErrorKind::NotFound => None,
+            Err(e) => return Err(error(&self.destination)(e)),
+        };
+        if let Some(metadata) = &previous {
+            let mut entries: Vec<fs::DirEntry> = fs::read_dir(&target)
+                .map_err(error(&target))?
+                .collect::<Result<_, _>>()
+                .map_err(error(&target))?;
+            entries.sort_by_key(fs::DirEntry::file_name);
+            for entry in entries {
+                let name = entry.file_name();
+                let into = staged.join(&name);
+                let written = fs::symlink_metadata(&into).is_ok();
+                if written || obsolete.iter().any(|o| OsStr::new(o) == name) {
+                    continue;
+                }
+                before(&CommitStep::Carry(name))
+                    .and_then(|()| carry(&entry.path(), &into))
+                    .map_err(error(&entry.path()))?;
+            }
+            fs::set_permissions(&staged, metadata.permissions()).map_err(error(&staged))?;
         }
-        sync_directory(&destination).map_err(error(&destination))
+        sync_directory(&staged).map_err(error(&staged))?;
+        let parent = parent_directory(&target);
+        if previous.is_none() {
+            before(&CommitStep::MoveIn)
+                .and_then(|()| fs::rename(&staged, &target))
+                .map_err(error(&self.destination))?;
+            let _ = self.directory.keep();
+            return sync_directory(&parent).map_err(error(&parent));
+        }
+        match before(&CommitStep::Exchange).and_then(|()| exchange(&staged, &target)) {
+            Ok(()) => {
+                sync_directory(&parent).map_err(error(&parent))?;
+                let old = self.directory.keep();
+                if before(&CommitStep::RemovePrevious).is_ok() {
+                    let _ = fs::remove_dir_all(old);
+                }
+                return Ok(());
+            }
+            Err(e) if e.kind() == io::ErrorKind::Unsupported => {}
+            Err(e) => return Err(error(&self.destination)(e)),
+        }
+        // No exchange: aside, in, and back if the second rename fails.
+        let name = target.file_name().unwrap_or_default();
+        let mut aside_name = temporary_prefix(name);
+        aside_name.push(format!("{PREVIOUS}.tmp-{}", std::process::id()));
+        let aside = parent.join(aside_name);
+        before(&CommitStep::MoveAside)
+            .and_then(|()| fs::rename(&target, &aside))
+            .map_err(error(&self.destination))?;
+        if let Err(e) = before(&CommitStep::MoveIn).and_then(|()| fs::rename(&staged, &target)) {
+            let _ = fs::rename(&aside, &target);
+            return Err(error(&self.destination)(e));
+        }
+        let _ = self.directory.keep();
+        sync_directory(&parent).map_err(error(&parent))?;
+        if before(&CommitStep::RemovePrevious).is_ok() {
+            let _ = fs::remove_dir_all(aside);
+        }
+        Ok(())
     }
+}
+
+/// Trades the directories `a` and `b` in one atomic step; `Unsupported` where the
+/// system or the file system cannot.
+#[cfg(any(target_os = "linux", target_os = "android", target_vendor = "apple"))]
+fn exchange(a: &Path, b: &Path) -> io::Result<()> {
+    use rustix::fs::{CWD, RenameFlags, renameat_with};
+    use rustix::io::Errno;
+    match renameat_with(CWD, a, CWD, b, RenameFlags::EXCHANGE) {
+        Ok(()) => Ok(()),
+        // An old kernel, or a file system without the flag.
+        Err(e) if e == Errno::INVAL || e == Errno::NOSYS || e == Errno::OPNOTSUPP => Err(
+            io::Error::new(io::ErrorKind::Unsupported, io::Error::from(e)),
+        ),
+        Err(e) => Err(e.into()),
+    }
+}
+
+#[cfg(not(any(target_os = "linux", target_os = "android", target_vendor = "apple")))]
+fn exchange(_a: &Path, _b: &Path) -> io::Result<()> {
+    Err(io::Error::from(io::ErrorKind::Unsupported))
+}
+
+/// Recreates `from` at `to` without touching `from`: a file as a hard link (a copy
+/// where no link can be made), a directory as a tree of them, a symbolic link as
+/// the same link.
+fn carry(from: &Path, to: &Path) -> io::Result<()> {
+    let metadata = fs::symlink_metadata(from)?;
+    let kind = metadata.file_type();
+    if kind.is_dir() {
+        fs::create_dir(to)?;
+        for entry in fs::read_dir(from)? {
+            let entry = entry?;
+            carry(&entry.path(), &to.join(entry.file_name()))?;
+        }
+        fs::set_permissions(to, metadata.permissions())
+    } else if kind.is_symlink() {
+        symlink(&fs::read_link(from)?, to)
+    } else {
+        fs::hard_link(from, to).or_else(|_| fs::copy(from, to).map(|_| ()))
+    }
+}
+
+#[cfg(unix)]
+fn symlink(link: &Path, at: &Path) -> io::Result<()> {
+    std::os::unix::fs::symlink(link, at)
+}
+
+#[cfg(not(unix))]
+fn symlink(link: &Path, at: &Path) -> io::Result<()> {
+    // The file the link points to, copied.
+    fs::copy(parent_directory(at).join(link), at).map(|_| ())
+}
+
+/// Renames back a previous destination that a commit killed between its two
+/// renames left aside (only when `target` is missing, and only one of a process
+/// that has ended).
+fn restore_previous(parent: &Path, name: &OsStr, target: &Path) -> io::Result<()> {
+    if fs::symlink_metadata(target).is_ok() {
+        return Ok(());
+    }
+    let prefix = temporary_prefix(name);
+    let Ok(entries) = fs::read_dir(parent) else {
+        return Ok(());
+    };
+    for entry in entries.flatten() {
+        let file_name = entry.file_name();
+        let Some(pid) = temporary_owner(&file_name, &prefix) else {
+            continue;
+        };
+        let aside = file_name.to_str().and_then(|n| {
+            n.strip_prefix(prefix.to_str()?)?
+                .strip_suffix(&format!(".tmp-{pid}"))
+        });
+        if aside == Some(PREVIOUS) && pid != std::process::id() && process_has_ended(pid) {
+            return fs::rename(entry.path(), target);
+        }
+    }
+    Ok(())
 }
 
 #[cfg(test)]

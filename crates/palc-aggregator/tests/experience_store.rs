@@ -307,7 +307,14 @@ fn a_non_finite_onset_is_refused_naming_it() {
 fn values_out_of_their_bounds_are_refused_naming_field_value_and_bound() {
     let dir = scratch();
     let path = dir.join("experience.json");
-    let cases: [(&str, fn(&mut Experience), &str, &str); 6] = [
+    /// What is spoilt, how, the field named and the bound named.
+    type Case = (
+        &'static str,
+        fn(&mut Experience),
+        &'static str,
+        &'static str,
+    );
+    let cases: [Case; 6] = [
         (
             "a step of 1 s",
             |e| e.metadata.dt = 1.0,
@@ -356,7 +363,7 @@ fn values_out_of_their_bounds_are_refused_naming_field_value_and_bound() {
         );
         assert!(experience.save(&path).is_err(), "{what}: saved");
     }
-    assert!(MAX_DEMONSTRATION_OFFSET_M > 3.75 * 2.0);
+    const { assert!(MAX_DEMONSTRATION_OFFSET_M > 3.75 * 2.0) };
     fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -208,15 +208,17 @@ impl Evaluation {
 /// `runs.json`, `runs.csv`, `example.json`, `manifest.json`, the figures (with
 /// the `plot` feature) and `REPORT.md`. Nothing is written before both configs
 /// are read and checked and the runs are planned; the outputs are written into a
-/// staging directory next to `options.out` and moved into it only when all are
-/// written, so an error leaves the previous results intact.
+/// staging directory next to `options.out`, which takes its place in one atomic
+/// exchange when all are written ([`Staging::commit`]), so `options.out` holds
+/// either all of the previous results or all of the new ones.
 pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcome, EvalError> {
     let evaluation = Evaluation::load(&options.config, options.quick)?;
     let plan = evaluation.plan()?;
     let example_spec = evaluation.example_spec()?;
     let jobs = options.jobs.unwrap_or_else(manifest::cores).max(1);
-    // Everything is written into a staging directory next to `--out` and moved into
-    // place at the end: a run that fails leaves the previous results as they were.
+    // Everything is written into a staging directory next to `--out`, swapped with it
+    // at the end: a run that fails leaves the previous results as they were. An
+    // `--out` that exists and is not a directory is refused here, before the runs.
     let staging = Staging::new(&options.out)?;
     let out = staging.path();
 
@@ -286,11 +288,9 @@ pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcom
         recorded: evaluation.harness.recorded(),
     });
     write(&out.join("REPORT.md"), &report_text)?;
-    // The example's files of an earlier run are removed when this one has none.
-    staging.commit(
-        &["manifest.json", "REPORT.md"],
-        &["example.json", "fig06-example.svg", "fig06-example.png"],
-    )?;
+    // The example's files of an earlier run are not carried over when this one has
+    // none.
+    staging.commit(&["example.json", "fig06-example.svg", "fig06-example.png"])?;
     let report = options.out.join("REPORT.md");
     Ok(Outcome {
         report,
