@@ -1,6 +1,5 @@
 //! The experience store: what was learned, versioned, saved without ever losing data.
 
-use std::fs;
 use std::path::Path;
 
 use palc_planner::Weights;
@@ -281,9 +280,9 @@ impl Experience {
     /// (truncated, edited, a zone model the zone filter refuses).
     pub fn load(path: impl AsRef<Path>) -> Result<Self, AggregatorError> {
         let path = path.as_ref();
-        let bytes = fs::read(path).map_err(|source| AggregatorError::Io {
+        let bytes = crate::input::read(path).map_err(|e| AggregatorError::Io {
             path: path.to_path_buf(),
-            source,
+            source: e.into_io(),
         })?;
         Self::from_json(&bytes, path)
     }

@@ -77,6 +77,7 @@ mod correction;
 mod error;
 mod experience;
 mod expert;
+pub mod input;
 mod lesson;
 mod onset;
 mod options;

@@ -408,3 +408,116 @@ fn user_expect_writes_the_expected_lane_change_of_a_user_file() {
     let output = palc(&["learn", "--user", "bad.toml"], &dir);
     fails_with(&output, &["bad.toml", "user.family.reaction_s"]);
 }
+
+/// Issue 47: `--jobs 100000` spawned threads until the system refused (55 s).
+#[test]
+fn eval_refuses_jobs_past_the_bound_before_any_work() {
+    let dir = scratch("eval-jobs");
+    let config = workspace_file("configs/stress/dense-eval.toml");
+    for jobs in ["100000", "0"] {
+        let output = palc(
+            &[
+                "eval",
+                "--quick",
+                "--config",
+                config.to_str().unwrap(),
+                "--out",
+                "out",
+                "--jobs",
+                jobs,
+            ],
+            &dir,
+        );
+        fails_with(&output, &["--jobs", jobs, "1 to 1024"]);
+    }
+    assert!(!dir.join("out").exists());
+}
+
+/// Issue 47: `eval --out` at an existing file ran the whole evaluation before
+/// saying "File exists".
+#[test]
+fn eval_refuses_an_out_that_is_a_file_before_the_runs_and_leaves_it() {
+    let dir = scratch("eval-out-file");
+    std::fs::write(dir.join("out"), "my file").unwrap();
+    let config = workspace_file("configs/stress/dense-eval.toml");
+    let output = palc(
+        &[
+            "eval",
+            "--quick",
+            "--config",
+            config.to_str().unwrap(),
+            "--out",
+            "out",
+        ],
+        &dir,
+    );
+    fails_with(&output, &["out", "not a directory"]);
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(!stdout.contains("runs"), "runs started: {stdout}");
+    assert_eq!(std::fs::read_to_string(dir.join("out")).unwrap(), "my file");
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
+}
+
+/// Issue 47: 10^6 seeds in an eval config started 1,000,001 runs.
+#[test]
+fn eval_refuses_a_config_past_its_run_bound_naming_the_file_and_the_field() {
+    let dir = scratch("eval-max-runs");
+    let base = workspace_file("configs/stress/dense.toml");
+    let seeds: Vec<String> = (0..1_000_000).map(|s| s.to_string()).collect();
+    let text = read("configs/stress/dense-eval.toml")
+        .replace(
+            "base = \"dense.toml\"",
+            &format!("base = \"{}\"", base.display()),
+        )
+        .replace("seeds = [1]", &format!("seeds = [{}]", seeds.join(", ")));
+    std::fs::write(dir.join("eval.toml"), &text).unwrap();
+    let output = palc(
+        &["eval", "--quick", "--config", "eval.toml", "--out", "out"],
+        &dir,
+    );
+    fails_with(&output, &["eval.toml", "max_runs", "100000"]);
+    assert!(!dir.join("out").exists());
+    // The bound is the config's to raise, or lower.
+    std::fs::write(
+        dir.join("eval.toml"),
+        text.replacen("\n[grid]", "\nmax_runs = 0\n[grid]", 1),
+    )
+    .unwrap();
+    let output = palc(
+        &["eval", "--quick", "--config", "eval.toml", "--out", "out"],
+        &dir,
+    );
+    fails_with(&output, &["eval.toml", "`max_runs` is 0", "at least 1"]);
+}
+
+/// Issue 47: an input file of any size was read whole (`zone fit --samples
+/// /dev/zero` aborted on a 2 GiB allocation).
+#[test]
+fn an_input_past_the_size_bound_is_refused_naming_the_file_its_size_and_the_bound() {
+    let dir = scratch("input-size");
+    let large = std::fs::File::create(dir.join("large.json")).unwrap();
+    // Sparse: 64 MiB and one byte, without writing them.
+    large.set_len(64 * 1024 * 1024 + 1).unwrap();
+    let output = palc(
+        &["plan", "--problem", "large.json", "--out", "plan.json"],
+        &dir,
+    );
+    fails_with(&output, &["large.json", "67108865 bytes", "67108864 bytes"]);
+    assert!(!dir.join("plan.json").exists());
+    let output = palc(&["learn", "--config", "large.json"], &dir);
+    fails_with(&output, &["large.json", "67108865 bytes", "67108864 bytes"]);
+    let output = palc(
+        &["zone", "fit", "--samples", "large.json", "--out", "m.json"],
+        &dir,
+    );
+    fails_with(&output, &["large.json", "67108865 bytes", "67108864 bytes"]);
+    #[cfg(target_os = "linux")]
+    {
+        let output = palc(
+            &["zone", "fit", "--samples", "/dev/zero", "--out", "m.json"],
+            &dir,
+        );
+        fails_with(&output, &["/dev/zero", "67108864 bytes"]);
+    }
+    assert!(!dir.join("m.json").exists());
+}

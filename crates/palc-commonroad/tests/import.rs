@@ -513,3 +513,28 @@ proptest! {
         }
     }
 }
+
+/// A scenario or recorded file larger than the input bound is refused from its
+/// size, naming the file, its size and the bound.
+#[test]
+fn a_file_past_the_size_bound_is_refused_before_it_is_read() {
+    let path = std::env::temp_dir().join(format!("palc-cr-large-{}.xml", std::process::id()));
+    let file = std::fs::File::create(&path).unwrap();
+    // Sparse: the bound and one byte, without writing them.
+    file.set_len(palc_commonroad::import::MAX_FILE_BYTES + 1)
+        .unwrap();
+    let message = palc_commonroad::import::import_file(&path)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains(&path.display().to_string())
+            && message.contains("67108865 bytes")
+            && message.contains("67108864 bytes"),
+        "{message}"
+    );
+    let message = palc_commonroad::import::RecordedLaneChanges::read(&path)
+        .unwrap_err()
+        .to_string();
+    assert!(message.contains("67108865 bytes"), "{message}");
+    std::fs::remove_file(&path).unwrap();
+}

@@ -51,6 +51,24 @@ pub enum EvalError {
         /// The bound it violates.
         bound: String,
     },
+    /// An option of the evaluation (not a field of its config) is out of its bound.
+    #[error("`{option}` is {value}, expected {bound}")]
+    InvalidOption {
+        /// The option, as on the command line (`--jobs`).
+        option: &'static str,
+        /// The value given.
+        value: String,
+        /// The bound it violates.
+        bound: String,
+    },
+    /// The config expands to more runs than it allows.
+    #[error(
+        "the config expands to more than {max_runs} runs, its bound `max_runs`; set `max_runs` higher for a study that large"
+    )]
+    TooManyRuns {
+        /// The bound.
+        max_runs: usize,
+    },
     /// A name (speed case, user kind) that the config does not define.
     #[error("unknown {kind} `{name}` in `{field}`: defined are {known:?}")]
     Unknown {

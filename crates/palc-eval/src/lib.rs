@@ -79,7 +79,7 @@ pub struct EvalOptions {
     pub out: PathBuf,
     /// Run the config's `[quick]` subset.
     pub quick: bool,
-    /// Worker threads; every core when `None`.
+    /// Worker threads, at most [`runner::MAX_JOBS`]; every core when `None`.
     pub jobs: Option<usize>,
 }
 
@@ -114,13 +114,15 @@ pub struct Evaluation {
     selection: Selection,
     harness: HarnessRuns,
     quick: bool,
+    max_runs: usize,
 }
 
+/// Reads a config, at most `palc_aggregator::input::MAX_INPUT_BYTES`.
 fn read(path: &Path) -> Result<String, EvalError> {
-    std::fs::read_to_string(path).map_err(|source| EvalError::Io {
+    palc_aggregator::input::read_to_string(path).map_err(|e| EvalError::Io {
         action: "read",
         path: path.to_owned(),
-        source,
+        source: e.into_io(),
     })
 }
 
@@ -131,6 +133,7 @@ impl Evaluation {
     pub fn load(config_path: &Path, quick: bool) -> Result<Evaluation, EvalError> {
         let text = read(config_path)?;
         let config = EvalConfig::from_toml_str(&text).map_err(|e| e.in_file(config_path))?;
+        let max_runs = config.max_runs.unwrap_or(plan::DEFAULT_MAX_RUNS);
         let base_path = config.base_path(config_path);
         let base_text = read(&base_path)?;
         let base = palc_harness::LearnConfig::from_toml_str(&base_text)
@@ -159,12 +162,14 @@ impl Evaluation {
             selection,
             harness,
             quick,
+            max_runs,
         })
     }
 
-    /// The runs of this evaluation, in output order.
+    /// The runs of this evaluation, in output order; refused past the config's
+    /// `max_runs` ([`plan::DEFAULT_MAX_RUNS`] by default).
     pub fn plan(&self) -> Result<RunPlan, EvalError> {
-        plan::expand(&self.selection, self.harness.testbed())
+        plan::expand_bounded(&self.selection, self.harness.testbed(), self.max_runs)
             .map_err(|e| e.in_file(&self.config_path))
     }
 
@@ -212,10 +217,13 @@ impl Evaluation {
 /// exchange when all are written ([`Staging::commit`]), so `options.out` holds
 /// either all of the previous results or all of the new ones.
 pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcome, EvalError> {
+    let jobs = match options.jobs {
+        Some(jobs) => runner::check_jobs(jobs)?,
+        None => manifest::cores().clamp(1, runner::MAX_JOBS),
+    };
     let evaluation = Evaluation::load(&options.config, options.quick)?;
     let plan = evaluation.plan()?;
     let example_spec = evaluation.example_spec()?;
-    let jobs = options.jobs.unwrap_or_else(manifest::cores).max(1);
     // Everything is written into a staging directory next to `--out`, swapped with it
     // at the end: a run that fails leaves the previous results as they were. An
     // `--out` that exists and is not a directory is refused here, before the runs.

@@ -166,6 +166,29 @@ impl RunPlan {
 
 /// Expands a selection; the timing runs' speed case is looked up in `testbed`.
 pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan, EvalError> {
+    expand_bounded(selection, testbed, DEFAULT_MAX_RUNS)
+}
+
+/// The bound on the runs of an evaluation when its config sets no `max_runs`.
+pub const DEFAULT_MAX_RUNS: usize = 100_000;
+
+/// Refuses a run past `max_runs` (`len` runs are planned already).
+fn room(len: usize, max_runs: usize) -> Result<(), EvalError> {
+    if len < max_runs {
+        Ok(())
+    } else {
+        Err(EvalError::TooManyRuns { max_runs })
+    }
+}
+
+/// [`expand`] with at most `max_runs` runs: the expansion stops with
+/// [`EvalError::TooManyRuns`] as soon as it would plan one more, so a config that
+/// would expand to millions of runs is refused before they are even listed.
+pub fn expand_bounded(
+    selection: &Selection,
+    testbed: &TestbedConfig,
+    max_runs: usize,
+) -> Result<RunPlan, EvalError> {
     let grid = &selection.grid;
     let drivers = |user: &UserKind| -> &[String] {
         (selection.drivers.get(&user.name)).map_or(&[], Vec::as_slice)
@@ -182,7 +205,8 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
                 user,
                 drivers,
                 None,
-            );
+                max_runs,
+            )?;
         }
     }
     let timing = &selection.timing;
@@ -192,6 +216,7 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
         for &dt in &timing.dts {
             for &margin in &timing.horizon_margins_s {
                 for style in &timing.styles {
+                    room(first.len(), max_runs)?;
                     first.push(RunSpec {
                         id: first.len(),
                         experiment: Experiment::Timing,
@@ -217,6 +242,7 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
         .cloned()
         .collect();
     for spec in closed_loop {
+        room(first.len(), max_runs)?;
         first.push(RunSpec {
             id: first.len(),
             experiment: Experiment::ClosedLoop,
@@ -237,7 +263,8 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
                 user,
                 drivers(user),
                 name,
-            );
+                max_runs,
+            )?;
         }
     }
     let mut transfer = Vec::new();
@@ -257,6 +284,7 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
         }
         let source = transfer_source(selection, target, &first);
         let Some(source) = source else { continue };
+        room(first.len() + transfer.len(), max_runs)?;
         transfer.push(RunSpec {
             id: first.len() + transfer.len(),
             experiment,
@@ -286,6 +314,7 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
                         && s.headway_m != target.headway_m))
         });
         for source in sources {
+            room(id(&first, &transfer), max_runs)?;
             transfer.push(RunSpec {
                 id: id(&first, &transfer),
                 experiment: Experiment::Matrix,
@@ -336,6 +365,7 @@ pub fn expand(selection: &Selection, testbed: &TestbedConfig) -> Result<RunPlan,
             let mut previous = start.id;
             for scene in chain {
                 let next = id(&first, &transfer);
+                room(next, max_runs)?;
                 transfer.push(RunSpec {
                     id: next,
                     experiment: Experiment::Accumulation,
@@ -361,7 +391,8 @@ fn grid_cells(
     user: &UserKind,
     drivers: &[String],
     rung: Option<String>,
-) {
+    max_runs: usize,
+) -> Result<(), EvalError> {
     let users: Vec<(StylePreset, UserKind)> = match &user.recorded {
         Some(_) => (drivers.iter())
             .map(|driver| {
@@ -380,6 +411,7 @@ fn grid_cells(
         for &headway_m in &grid.headways_m {
             for (style, user) in &users {
                 for &seed in &grid.seeds {
+                    room(runs.len(), max_runs)?;
                     runs.push(RunSpec {
                         id: runs.len(),
                         experiment,
@@ -398,6 +430,7 @@ fn grid_cells(
             }
         }
     }
+    Ok(())
 }
 
 /// The phase-one run (of `target`'s experiment and rung) whose experience
@@ -514,6 +547,34 @@ pub(crate) mod tests {
             ablation: crate::ablation::AblationConfig::default(),
             drivers: Default::default(),
         }
+    }
+
+    #[test]
+    fn a_config_past_its_run_bound_is_refused_before_its_runs_are_listed() {
+        let selection = selection();
+        let all = expand(&selection, &testbed()).unwrap().len();
+        assert!(all < DEFAULT_MAX_RUNS);
+        assert_eq!(
+            expand_bounded(&selection, &testbed(), all).unwrap().len(),
+            all
+        );
+        for max_runs in [1, 10, all - 1] {
+            let error = expand_bounded(&selection, &testbed(), max_runs).unwrap_err();
+            let message = error.to_string();
+            assert!(
+                matches!(error, EvalError::TooManyRuns { max_runs: m } if m == max_runs)
+                    && message.contains("max_runs")
+                    && message.contains(&max_runs.to_string()),
+                "{message}"
+            );
+        }
+        // A million seeds stop at the bound, not after a million runs are listed.
+        let mut huge = selection.clone();
+        huge.grid.seeds = (0..1_000_000).collect();
+        assert!(matches!(
+            expand(&huge, &testbed()),
+            Err(EvalError::TooManyRuns { .. })
+        ));
     }
 
     #[test]

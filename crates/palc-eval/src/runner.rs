@@ -47,7 +47,27 @@ pub struct NoProgress;
 
 impl Progress for NoProgress {}
 
-/// Runs every spec of `plan` on `jobs` threads; the rows are in plan order.
+/// The most worker threads an evaluation may start (`--jobs`).
+pub const MAX_JOBS: usize = 1024;
+
+/// `jobs` if it lies in `1..=MAX_JOBS`.
+///
+/// # Errors
+/// [`EvalError::InvalidOption`] naming `--jobs`, the value and the bound.
+pub fn check_jobs(jobs: usize) -> Result<usize, EvalError> {
+    if (1..=MAX_JOBS).contains(&jobs) {
+        Ok(jobs)
+    } else {
+        Err(EvalError::InvalidOption {
+            option: "--jobs",
+            value: jobs.to_string(),
+            bound: format!("1 to {MAX_JOBS} threads"),
+        })
+    }
+}
+
+/// Runs every spec of `plan` on `jobs` threads (at most [`MAX_JOBS`]); the rows
+/// are in plan order.
 pub fn execute<E: Executor>(
     plan: &RunPlan,
     executor: &E,
@@ -55,7 +75,7 @@ pub fn execute<E: Executor>(
     progress: &dyn Progress,
 ) -> Result<Vec<RunRow>, EvalError> {
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(jobs.max(1))
+        .num_threads(check_jobs(jobs)?)
         .build()?;
     progress.started(plan.len());
     let sources: Vec<usize> = plan
@@ -338,5 +358,25 @@ pub(crate) mod tests {
                 assert!(row.takeovers <= without.takeovers);
             }
         }
+    }
+
+    #[test]
+    fn jobs_past_the_bound_are_refused_naming_the_option_and_the_bound() {
+        assert_eq!(check_jobs(1).unwrap(), 1);
+        assert_eq!(check_jobs(MAX_JOBS).unwrap(), MAX_JOBS);
+        for jobs in [0, MAX_JOBS + 1, 100_000] {
+            let message = check_jobs(jobs).unwrap_err().to_string();
+            assert!(
+                message.contains("--jobs")
+                    && message.contains(&jobs.to_string())
+                    && message.contains("1024"),
+                "{message}"
+            );
+        }
+        let plan = RunPlan {
+            first: Vec::new(),
+            transfer: Vec::new(),
+        };
+        assert!(execute(&plan, &Synthetic, 100_000, &NoProgress).is_err());
     }
 }

@@ -21,7 +21,7 @@ pub struct EvalArgs {
     /// Output directory.
     #[arg(long, default_value = "target/reproduce-paper")]
     out: PathBuf,
-    /// Worker threads (default: every core).
+    /// Worker threads (default: every core; at most 1024).
     #[arg(long)]
     jobs: Option<usize>,
     /// The evaluation config.

@@ -61,7 +61,7 @@ pub struct LearnArgs {
 
 /// Reads a file for a command, naming it in the error.
 fn read(path: &Path) -> anyhow::Result<String> {
-    std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))
+    Ok(palc_aggregator::input::read_to_string(path)?)
 }
 
 /// The learning config of `args`: the config file (or the built-in one) with the

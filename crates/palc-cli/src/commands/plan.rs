@@ -26,7 +26,7 @@
 //! `unbounded`, `solver_failed`) after writing the output, one of the input
 //! (`invalid_input`, `non_convex` weights) on stderr alone, with `--out` untouched.
 
-use std::{fs::File, io::BufReader, path::PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, bail};
 use clap::Args;
@@ -82,8 +82,8 @@ fn refusal_status(error: &PlanError) -> &'static str {
 /// Runs `palc plan`.
 pub fn run(args: PlanArgs) -> anyhow::Result<()> {
     let path = &args.problem;
-    let file = File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
-    let input: PlanInput = crate::parse::json(BufReader::new(file))
+    let bytes = palc_aggregator::input::read(path)?;
+    let input: PlanInput = crate::parse::json(bytes.as_slice())
         .with_context(|| format!("cannot read the plan problem in {}", path.display()))?;
     let result = Planner::new(input.config).and_then(|mut planner| planner.plan(&input.problem));
     let output = match &result {

@@ -67,8 +67,7 @@ pub fn run(args: TrafficArgs) -> anyhow::Result<()> {
 }
 
 fn simulate(args: &SimulateArgs) -> anyhow::Result<()> {
-    let text = std::fs::read_to_string(&args.config)
-        .with_context(|| format!("cannot read config {}", args.config.display()))?;
+    let text = palc_aggregator::input::read_to_string(&args.config)?;
     let config = ScenarioConfig::from_toml_str(&text)
         .with_context(|| format!("in {}", args.config.display()))?;
     let mut scene = Scene::from_config(&config, args.cell)

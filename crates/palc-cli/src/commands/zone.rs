@@ -13,14 +13,13 @@
 //! - model: JSON written by `ZoneModel`'s serde form (format version, config, statistics).
 
 use std::{
-    fs::File,
-    io::{BufReader, Read, Write},
+    io::{Cursor, Read, Write},
     path::{Path, PathBuf},
 };
 
 use anyhow::{Context, bail};
 use clap::{Args, Subcommand, ValueEnum};
-use palc_aggregator::output;
+use palc_aggregator::{input, output};
 use palc_zone_filter::{Discriminant, FeatureSet, Label, Sample, ZoneConfig, ZoneModel};
 use serde::Serialize;
 
@@ -93,8 +92,7 @@ pub fn run(args: ZoneArgs) -> anyhow::Result<()> {
 fn fit(args: &FitArgs) -> anyhow::Result<()> {
     let mut config = match &args.config {
         Some(path) => {
-            let text = std::fs::read_to_string(path)
-                .with_context(|| format!("cannot read config {}", path.display()))?;
+            let text = input::read_to_string(path)?;
             let config = parse::toml::<ZoneConfig>(&text)
                 .with_context(|| format!("in {}", path.display()))?;
             config
@@ -135,9 +133,7 @@ fn fit(args: &FitArgs) -> anyhow::Result<()> {
 }
 
 fn classify(args: &ClassifyArgs) -> anyhow::Result<()> {
-    let file =
-        File::open(&args.model).with_context(|| format!("cannot open {}", args.model.display()))?;
-    let model: ZoneModel = parse::json(BufReader::new(file))
+    let model: ZoneModel = parse::json(open(&args.model)?)
         .with_context(|| format!("in model {}", args.model.display()))?;
     let set = model.config().feature_set;
     let rows = read_points(&args.points, set)?;
@@ -182,10 +178,9 @@ fn is_json(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("json"))
 }
 
-fn open(path: &Path) -> anyhow::Result<BufReader<File>> {
-    Ok(BufReader::new(File::open(path).with_context(|| {
-        format!("cannot open {}", path.display())
-    })?))
+/// The bytes of an input file, at most `input::MAX_INPUT_BYTES`.
+fn open(path: &Path) -> anyhow::Result<Cursor<Vec<u8>>> {
+    Ok(Cursor::new(input::read(path)?))
 }
 
 fn read_samples(path: &Path, set: FeatureSet) -> anyhow::Result<Vec<Sample>> {

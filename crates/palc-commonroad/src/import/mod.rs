@@ -118,12 +118,45 @@ pub fn import_str(text: &str, file: &str) -> Result<ScenarioImport, ImportError>
     })
 }
 
+/// The most bytes read from one input file (64 MiB), as for every input of `palc`.
+pub const MAX_FILE_BYTES: u64 = 64 * 1024 * 1024;
+
+/// The text of the file at `path`, refused past [`MAX_FILE_BYTES`] (from its size
+/// for a regular file, after reading that many bytes for a stream).
+pub(crate) fn read_bounded(path: &Path) -> std::io::Result<String> {
+    use std::io::Read;
+    let too_large = |size: Option<u64>| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            match size {
+                Some(size) => format!(
+                    "it holds {size} bytes, more than the bound of {MAX_FILE_BYTES} bytes on an input file"
+                ),
+                None => format!(
+                    "it holds more than the bound of {MAX_FILE_BYTES} bytes on an input file"
+                ),
+            },
+        )
+    };
+    let file = std::fs::File::open(path)?;
+    let metadata = file.metadata()?;
+    if metadata.is_file() && metadata.len() > MAX_FILE_BYTES {
+        return Err(too_large(Some(metadata.len())));
+    }
+    let mut text = String::new();
+    file.take(MAX_FILE_BYTES + 1).read_to_string(&mut text)?;
+    if text.len() as u64 > MAX_FILE_BYTES {
+        return Err(too_large(None));
+    }
+    Ok(text)
+}
+
 /// Imports the scenario in the file at `path` (named by its file name in the [`Source`]).
 ///
 /// # Errors
 /// [`ImportError::Io`] when the file cannot be read, otherwise as [`import_str`].
 pub fn import_file(path: &Path) -> Result<ScenarioImport, ImportError> {
-    let text = std::fs::read_to_string(path).map_err(|error| ImportError::Io {
+    let text = read_bounded(path).map_err(|error| ImportError::Io {
         path: path.to_owned(),
         error,
     })?;

@@ -305,7 +305,7 @@ impl RecordedLaneChanges {
     /// [`ReadError`] naming the file, and for a bad value the field, the value and its
     /// bound.
     pub fn read(path: &Path) -> Result<Self, ReadError> {
-        let text = std::fs::read_to_string(path).map_err(|error| ReadError::Io {
+        let text = super::read_bounded(path).map_err(|error| ReadError::Io {
             path: path.to_owned(),
             error,
         })?;
