@@ -131,10 +131,10 @@ impl AggregatorOptions {
                 reason: "the zone_centre expert needs the zone: set use_zone = true or use the lesson expert",
             });
         }
-        if self.use_zone {
-            self.zone.validate()?;
-            self.bounds.validate()?;
-        }
+        // Checked also when the zone is off: a value that cannot be right is
+        // refused wherever it is written.
+        self.zone.validate()?;
+        self.bounds.validate()?;
         Ok(())
     }
 }

@@ -521,3 +521,175 @@ fn an_input_past_the_size_bound_is_refused_naming_the_file_its_size_and_the_boun
     }
     assert!(!dir.join("m.json").exists());
 }
+
+/// `configs/learn.toml` with `from` replaced by `to`, written into `dir`.
+fn learn_config_with(dir: &Path, from: &str, to: &str) -> PathBuf {
+    let text = read("configs/learn.toml");
+    assert!(text.contains(from), "{from}");
+    let path = dir.join("learn.toml");
+    std::fs::write(&path, text.replacen(from, to, 1)).unwrap();
+    path
+}
+
+/// Issue 47: values that cannot be right were accepted in a learning config
+/// (`planning.target_l` off the road reported "Personalized", `[aggregator]`
+/// options read only deep in the run, inverted braking bounds). Each is refused
+/// at load time, naming the file, the field path, the value and the bound (with
+/// the other field of an inconsistency).
+#[test]
+fn learn_refuses_values_that_cannot_be_right_naming_file_field_value_and_bound() {
+    let dir = scratch("learn-cannot-be-right");
+    let cases: [(&str, &str, &[&str]); 9] = [
+        (
+            "[planning]\n",
+            "[planning]\ntarget_l = 7.0\n",
+            &[
+                "planning.target_l",
+                "7.0",
+                "traffic.road.lane_width_m",
+                "3.5",
+            ],
+        ),
+        (
+            "[planning]\n",
+            "[planning]\ntarget_l = -3.5\n",
+            &["planning.target_l", "-3.5"],
+        ),
+        (
+            "[planning]\n",
+            "[planning]\ntarget_l = 0.0\n",
+            &["planning.target_l", "0.0"],
+        ),
+        (
+            "lane_width_m = 3.5",
+            "lane_width_m = 4.0",
+            &[
+                "planning.target_l",
+                "3.5",
+                "traffic.road.lane_width_m",
+                "4.0",
+            ],
+        ),
+        (
+            "min_braking_mps2 = 6.0",
+            "min_braking_mps2 = 8.0",
+            &[
+                "planning.safety.min_braking_mps2",
+                "8.0",
+                "planning.safety.max_braking_mps2",
+            ],
+        ),
+        (
+            "[loop]",
+            "[aggregator.correction]\nrule = \"target\"\ntolerance_m = nan\n\n[loop]",
+            &["aggregator.correction.tolerance_m", "NaN", ">= 0"],
+        ),
+        (
+            "[loop]",
+            "[aggregator.bounds]\ngrid_step = 0.0\n\n[loop]",
+            &["aggregator.bounds.grid_step", "0.0", "positive"],
+        ),
+        (
+            "[loop]",
+            "[aggregator.bounds]\nlateral_range = [5.0, -1.0]\n\n[loop]",
+            &[
+                "aggregator.bounds.lateral_range",
+                "lateral_range[0] < lateral_range[1]",
+            ],
+        ),
+        (
+            "[loop]",
+            "[aggregator.zone]\nridge = -1.0\n\n[loop]",
+            &["aggregator.zone.ridge", "-1.0", ">= 0"],
+        ),
+    ];
+    for (from, to, needles) in cases {
+        let config = learn_config_with(&dir, from, to);
+        let output = palc(
+            &[
+                "learn",
+                "--config",
+                config.to_str().unwrap(),
+                "--save-experience",
+                "e.json",
+            ],
+            &dir,
+        );
+        let mut needles = needles.to_vec();
+        needles.push("learn.toml");
+        fails_with(&output, &needles);
+        assert!(!dir.join("e.json").exists(), "{to}");
+    }
+}
+
+/// Issue 47: two speed cases with the same name (the first won) and a vehicle
+/// wider than its lane were accepted.
+#[test]
+fn traffic_refuses_duplicate_speed_cases_and_vehicles_wider_than_their_lane() {
+    let dir = scratch("traffic-cannot-be-right");
+    let cases: [(&str, &str, &[&str]); 2] = [
+        (
+            "name = \"collector-slow\"",
+            "name = \"collector-high\"",
+            &[
+                "testbed.speed_cases[1].name",
+                "collector-high",
+                "testbed.speed_cases[0]",
+            ],
+        ),
+        (
+            "width_m = 1.8",
+            "width_m = 10.0",
+            &["vehicle.width_m", "10.0", "road.lane_width_m", "3.5"],
+        ),
+    ];
+    for (from, to, needles) in cases {
+        let config = testbed_with(&dir, from, to);
+        let output = palc(
+            &[
+                "traffic",
+                "simulate",
+                "--config",
+                config.to_str().unwrap(),
+                "--out",
+                "t.csv",
+            ],
+            &dir,
+        );
+        fails_with(&output, needles);
+        assert!(!dir.join("t.csv").exists());
+    }
+}
+
+/// Issue 47: plan bounds with min > max were planned through and reported
+/// "solved" (soft bounds).
+#[test]
+fn plan_refuses_a_bound_with_min_above_max_and_touches_no_output() {
+    let dir = scratch("plan-inverted-bound");
+    let text = read("configs/examples/plan-problem.json");
+    let mut problem: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let horizon = problem["problem"]["reference_speed"]
+        .as_array()
+        .unwrap()
+        .len();
+    let mut bounds = vec![serde_json::Value::Null; horizon + 1];
+    bounds[5] = serde_json::json!({"min": 2.0, "max": 1.0});
+    problem["problem"]["lateral_bounds"] = serde_json::Value::Array(bounds);
+    std::fs::write(dir.join("p.json"), problem.to_string()).unwrap();
+    std::fs::write(dir.join("out.json"), "previous").unwrap();
+    let output = palc(&["plan", "--problem", "p.json", "--out", "out.json"], &dir);
+    fails_with(
+        &output,
+        &[
+            "p.json",
+            "problem.lateral_bounds[5].min",
+            "2.0",
+            "problem.lateral_bounds[5].max",
+            "1.0",
+        ],
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.join("out.json")).unwrap(),
+        "previous"
+    );
+}

@@ -95,6 +95,16 @@ impl SafetyConfig {
                 });
             }
         }
+        if self.min_braking_mps2 > self.max_braking_mps2 {
+            return Err(HarnessError::InvalidConfig {
+                field: format!("{table}.min_braking_mps2"),
+                value: self.min_braking_mps2,
+                bound: format!(
+                    "at most `{table}.max_braking_mps2` = {:?}",
+                    self.max_braking_mps2
+                ),
+            });
+        }
         Ok(())
     }
 

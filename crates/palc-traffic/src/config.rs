@@ -350,6 +350,17 @@ impl ScenarioConfig {
         self.road()?;
         positive("vehicle.length_m", self.vehicle.length_m)?;
         positive("vehicle.width_m", self.vehicle.width_m)?;
+        // A vehicle wider than its lane touches the next one from any position.
+        if self.vehicle.width_m > self.road.lane_width_m {
+            return Err(out_of_range(
+                "vehicle.width_m",
+                self.vehicle.width_m,
+                &format!(
+                    "at most `road.lane_width_m` = {:?} m, to fit its lane",
+                    self.road.lane_width_m
+                ),
+            ));
+        }
         let idm = &self.idm;
         positive("idm.t_s", idm.t_s)?;
         non_negative("idm.s0_m", idm.s0_m)?;
@@ -369,6 +380,19 @@ impl ScenarioConfig {
                 idm.desired_speed_ratio,
                 "above 1",
             ));
+        }
+        if let Some(testbed) = &self.testbed {
+            for (i, case) in testbed.speed_cases.iter().enumerate() {
+                if let Some(first) =
+                    (testbed.speed_cases[..i].iter()).position(|c| c.name == case.name)
+                {
+                    return Err(ConfigError::DuplicateName {
+                        field: format!("testbed.speed_cases[{i}].name"),
+                        name: case.name.clone(),
+                        first: format!("testbed.speed_cases[{first}]"),
+                    });
+                }
+            }
         }
         if let Some(lag) = self.testbed.as_ref().and_then(|t| t.lag_accelerating) {
             lag.validate(self.road.lane_width_m)?;

@@ -29,6 +29,16 @@ pub enum ConfigError {
         /// The allowed range, in words.
         bound: String,
     },
+    /// Two entries of a list have the same name (the first would win).
+    #[error("`{field}` = {name:?} is the name of `{first}` already: names must be unique")]
+    DuplicateName {
+        /// Dotted path of the second field with the name.
+        field: String,
+        /// The name.
+        name: String,
+        /// Dotted path of the first field with the name.
+        first: String,
+    },
     /// A list that must have at least one element is empty.
     #[error("`{field}` is empty: it needs at least one entry")]
     Empty {

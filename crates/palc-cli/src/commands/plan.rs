@@ -85,6 +85,19 @@ pub fn run(args: PlanArgs) -> anyhow::Result<()> {
     let bytes = palc_aggregator::input::read(path)?;
     let input: PlanInput = crate::parse::json(bytes.as_slice())
         .with_context(|| format!("cannot read the plan problem in {}", path.display()))?;
+    // A bound with min > max allows no `l`; soft bounds would plan through it and
+    // report "solved", so the input is refused (the planner's hard mode says
+    // `ZoneTooNarrow` itself, for bounds a zone filter computed).
+    let inverted = (input.problem.lateral_bounds.iter().enumerate()).find_map(|(i, b)| {
+        let (min, max) = (b.as_ref()?.min?, b.as_ref()?.max?);
+        (min > max).then_some((i, min, max))
+    });
+    if let Some((i, min, max)) = inverted {
+        bail!(
+            "{}: `problem.lateral_bounds[{i}].min` is {min:?}, expected at most `problem.lateral_bounds[{i}].max` = {max:?}",
+            path.display()
+        );
+    }
     let result = Planner::new(input.config).and_then(|mut planner| planner.plan(&input.problem));
     let output = match &result {
         Ok(plan) => PlanOutput {

@@ -216,6 +216,44 @@ impl std::fmt::Display for UserStyle {
     }
 }
 
+/// How far `planning.target_l` may lie from the target lane's centre (m).
+pub const TARGET_L_TOLERANCE_M: f64 = 1e-6;
+
+/// Checks `[aggregator]`, naming each field by its path in the config.
+pub(crate) fn validate_aggregator(
+    options: &palc_aggregator::AggregatorOptions,
+) -> Result<(), HarnessError> {
+    let in_table = |table: &str, error: palc_zone_filter::ZoneError| match error {
+        palc_zone_filter::ZoneError::InvalidConfig {
+            field,
+            value,
+            bound,
+        } => HarnessError::InvalidConfig {
+            field: format!("aggregator.{table}.{field}"),
+            value,
+            bound: bound.to_owned(),
+        },
+        other => HarnessError::Zone(other),
+    };
+    options.zone.validate().map_err(|e| in_table("zone", e))?;
+    options
+        .bounds
+        .validate()
+        .map_err(|e| in_table("bounds", e))?;
+    options.validate().map_err(|error| match error {
+        palc_aggregator::AggregatorError::InvalidOption {
+            field,
+            value,
+            bound,
+        } => HarnessError::InvalidConfig {
+            field: format!("aggregator.{field}"),
+            value,
+            bound: bound.to_owned(),
+        },
+        other => HarnessError::Aggregator(other),
+    })
+}
+
 /// Largest `loop.max_takeovers`: a run keeps a record of every lane change, so the
 /// caps on a run's length bound its memory.
 pub const MAX_TAKEOVERS: usize = 1_000;
@@ -303,6 +341,10 @@ impl LearnConfig {
         self.planning.validate()?;
         self.standard_weights.validate()?;
         self.user.simulated(self.planning.takeover_threshold_m)?;
+        self.validate_target_l()?;
+        if let Some(options) = &self.aggregator {
+            validate_aggregator(options)?;
+        }
         let s = &self.stopping;
         for (field, value, max) in [
             ("loop.max_takeovers", s.max_takeovers, MAX_TAKEOVERS),
@@ -334,6 +376,34 @@ impl LearnConfig {
                 field: "loop.spread_margin".to_owned(),
                 value: s.spread_margin,
                 bound: "a value in [0, 1]".to_owned(),
+            });
+        }
+        Ok(())
+    }
+
+    /// `planning.target_l` is the centre of the target lane: lane 1, one lane
+    /// width from the ego's lane 0 (a lane change of the test bed).
+    fn validate_target_l(&self) -> Result<(), HarnessError> {
+        let road = &self.traffic.road;
+        let target_l = self.planning.target_l;
+        if road.lanes < 2 {
+            return Err(HarnessError::InvalidConfig {
+                field: "planning.target_l".to_owned(),
+                value: target_l,
+                bound: format!(
+                    "the centre of a target lane, but `traffic.road.lanes` = {} has none",
+                    road.lanes
+                ),
+            });
+        }
+        if (target_l - road.lane_width_m).abs() > TARGET_L_TOLERANCE_M {
+            return Err(HarnessError::InvalidConfig {
+                field: "planning.target_l".to_owned(),
+                value: target_l,
+                bound: format!(
+                    "the centre of the target lane, `traffic.road.lane_width_m` = {:?} m (within {TARGET_L_TOLERANCE_M:?} m)",
+                    road.lane_width_m
+                ),
             });
         }
         Ok(())
