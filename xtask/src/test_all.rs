@@ -4,8 +4,11 @@
 //! export: a virtual environment in `target/venv` (created once, its packages
 //! installed again only when `python/requirements-test.txt` changes), a release
 //! build of `palc`, `palc export commonroad` for the default scene and the grid
-//! into `target/commonroad-export`, and `pytest python`, which writes
-//! `target/commonroad-check/SUMMARY.md`.
+//! into `target/commonroad-export`, and `pytest python/commonroad`, which writes
+//! `target/commonroad-check/SUMMARY.md`. Last, the Python package: `maturin
+//! develop --release` into the same venv and `pytest python/tests`, which compares
+//! it with the `palc` binary just built and runs `mypy.stubtest`, which fails when
+//! the hand-written stubs no longer match the native module.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -41,8 +44,9 @@ pub fn run(args: impl Iterator<Item = String>) -> anyhow::Result<()> {
         )?;
     }
 
-    heading("Python environment for the CommonRoad checks (target/venv)");
-    let python = venv(&target.join("venv"))?;
+    heading("Python environment for the CommonRoad checks and the package (target/venv)");
+    let venv_dir = target.join("venv");
+    let python = venv(&venv_dir)?;
 
     heading("palc export commonroad (release build; the default scene and the grid)");
     status(
@@ -81,21 +85,61 @@ pub fn run(args: impl Iterator<Item = String>) -> anyhow::Result<()> {
         status(&mut command, "palc export commonroad")?;
     }
 
-    heading("pytest python (commonroad-io and the drivability checker)");
+    heading("pytest python/commonroad (commonroad-io and the drivability checker)");
     status(
         Command::new(&python)
-            .args(["-m", "pytest", "python", "-q", "-p", "no:cacheprovider"])
+            .args([
+                "-m",
+                "pytest",
+                "python/commonroad",
+                "-q",
+                "-p",
+                "no:cacheprovider",
+            ])
             .env("PALC_COMMONROAD_EXPORT", &export)
             .env(
                 "PALC_COMMONROAD_SUMMARY",
                 target.join("commonroad-check").join("SUMMARY.md"),
             ),
-        "pytest python",
+        "pytest python/commonroad",
     )?;
+
+    python_package(&python, &venv_dir, &target, &palc)?;
     println!(
         "\nall tests passed; the KS feasibility of the grid is in target/commonroad-check/SUMMARY.md"
     );
     Ok(())
+}
+
+/// The Python package: built into `venv` by maturin (release), then its tests, which
+/// compare it with the `palc` binary and check its stubs with `mypy.stubtest`.
+fn python_package(python: &Path, venv: &Path, target: &Path, palc: &Path) -> anyhow::Result<()> {
+    let absolute = |p: &Path| {
+        std::path::absolute(p).with_context(|| format!("cannot resolve {}", p.display()))
+    };
+    heading("the Python package (maturin develop --release into target/venv)");
+    let maturin = ["-m", "maturin", "develop", "--release", "--quiet"];
+    let mut command = Command::new(python);
+    command.args(maturin).env("VIRTUAL_ENV", absolute(venv)?);
+    status(
+        command.env("CARGO_TARGET_DIR", target),
+        "maturin develop --release",
+    )?;
+
+    heading("pytest python/tests (the palc package against the palc binary, its stubs)");
+    let pytest = [
+        "-m",
+        "pytest",
+        "python/tests",
+        "-q",
+        "-p",
+        "no:cacheprovider",
+    ];
+    let mut command = Command::new(python);
+    status(
+        command.args(pytest).env("PALC_BIN", absolute(palc)?),
+        "pytest python/tests",
+    )
 }
 
 fn heading(text: &str) {

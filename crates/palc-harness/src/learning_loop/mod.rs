@@ -280,16 +280,19 @@ impl LearningLoop {
     }
 
     /// Runs [`LearningLoop::step`] until [`LearningLoop::termination`] says the run
-    /// is over, then tells the observer the summary.
+    /// is over, then tells the observer the summary. A caller that drove some steps
+    /// itself (lane change by lane change, as the Python package's iterator does)
+    /// gets the same result: a run that is already over takes no further step.
     ///
     /// # Errors
     /// Those of [`LearningLoop::step`].
     pub fn run(mut self, observer: &mut dyn Observer) -> Result<RunResult, HarnessError> {
         let outcome = loop {
-            self.step(observer)?;
+            // A fresh loop is never over: every cap and the success streak are >= 1.
             if let Some(outcome) = self.termination() {
                 break outcome;
             }
+            self.step(observer)?;
         };
         let mut summary = self.run.summary(outcome, &self.policy.stopping);
         summary.frozen = self.frozen_evaluation(observer)?;

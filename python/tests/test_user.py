@@ -1,0 +1,94 @@
+"""Drivers written in Python and the learning loop lane change by lane change."""
+
+from __future__ import annotations
+
+import traceback
+
+import numpy as np
+import pytest
+
+import palc
+from conftest import LEARN_CONFIG
+
+
+class Neutral(palc.User):
+    """The paper's neutral driver in a few lines: it starts when the time headway
+    to the preceding vehicle falls to 1.23 s and changes lanes in 2.1 s."""
+
+    name = "neutral in Python"
+
+    def nominal(self, scene: palc.Scene) -> palc.LaneChange:
+        headway = scene["situations"]["time_headway_s"]
+        start = int(np.argmax(headway <= 1.23))
+        return {"start_s": start * scene["dt"], "duration_s": 2.1}
+
+
+class Broken(Neutral):
+    def next(self, scene: palc.Scene) -> palc.LaneChange:
+        raise KeyError("no such habit")
+
+
+def config() -> palc.LearnConfig:
+    return palc.LearnConfig.from_toml(LEARN_CONFIG)
+
+
+def test_the_loop_yields_every_lane_change_and_the_same_result_as_learn() -> None:
+    whole = palc.learn(config())
+    learning = palc.LearningLoop(config())
+    records = list(learning)
+    assert learning.outcome == whole.outcome
+    result = learning.result()
+    assert result.summary == whole.summary
+    assert len(records) == len(whole.records) == result.lane_changes
+    for mine, theirs in zip(records, whole.records):
+        assert mine["index"] == theirs["index"]
+        assert np.array_equal(mine["planned_l"], theirs["planned_l"])
+    with pytest.raises(palc.PalcError, match="result"):
+        next(learning)
+
+
+def test_result_runs_a_loop_to_its_end() -> None:
+    learning = palc.LearningLoop(config())
+    first = next(learning)
+    assert first["index"] == 0
+    assert learning.result().summary == palc.learn(config()).summary
+
+
+def test_a_python_driver_is_taught_by_the_loop() -> None:
+    result = palc.learn(config(), user=Neutral())
+    assert result.outcome == "personalized"
+    assert result.lane_changes >= 3
+    last = result.records[-1]
+    assert np.abs(last["planned_l"] - last["expected_l"]).max() <= 0.3
+
+
+def test_a_python_driver_like_the_built_in_one_gives_its_run() -> None:
+    ours = palc.learn(config(), user=Neutral())
+    built_in = palc.learn(config())
+    assert ours.summary == built_in.summary
+    for mine, theirs in zip(ours.records, built_in.records):
+        assert np.array_equal(mine["expected_l"], theirs["expected_l"])
+
+
+def test_an_exception_in_a_python_driver_surfaces_with_its_traceback() -> None:
+    with pytest.raises(KeyError, match="no such habit") as caught:
+        palc.learn(config(), user=Broken())
+    frames = traceback.extract_tb(caught.value.__traceback__)
+    assert any(frame.name == "next" for frame in frames)
+
+
+def test_a_bad_answer_names_the_field() -> None:
+    class Late(Neutral):
+        def nominal(self, scene: palc.Scene) -> palc.LaneChange:
+            return {"start_s": 1e6, "duration_s": 2.1}
+
+    with pytest.raises(palc.PalcError, match="start_s"):
+        palc.learn(config(), user=Late())
+
+    class Misspelt(Neutral):
+        def nominal(self, scene: palc.Scene) -> palc.LaneChange:
+            return {"start_s": 1.0, "duration": 2.1}  # type: ignore[typeddict-item]
+
+    with pytest.raises(palc.ConfigError) as caught:
+        palc.learn(config(), user=Misspelt())
+    assert "duration" in str(caught.value)
