@@ -123,12 +123,43 @@ fn parent_directory(path: &Path) -> PathBuf {
     }
 }
 
-/// `.name.` : every temporary of `name` starts with it (a hidden file).
+/// The most bytes of a target's name that its temporaries' names repeat: with the
+/// dots, the random part, `previous` and `.tmp-<pid>` they stay within the 255
+/// bytes a name may have on common file systems, so a target named up to that
+/// limit can be written.
+const MAX_NAME_IN_TEMPORARY: usize = 200;
+
+/// `.name.` : every temporary of `name` starts with it (a hidden file); a name
+/// longer than [`MAX_NAME_IN_TEMPORARY`] bytes is cut there (at a character
+/// boundary when it is UTF-8).
 fn temporary_prefix(file_name: &OsStr) -> OsString {
     let mut prefix = OsString::from(".");
-    prefix.push(file_name);
+    prefix.push(shortened(file_name));
     prefix.push(".");
     prefix
+}
+
+/// `name` cut to at most [`MAX_NAME_IN_TEMPORARY`] bytes.
+fn shortened(name: &OsStr) -> OsString {
+    if name.len() <= MAX_NAME_IN_TEMPORARY {
+        return name.to_owned();
+    }
+    if let Some(text) = name.to_str() {
+        let mut end = MAX_NAME_IN_TEMPORARY;
+        while !text.is_char_boundary(end) {
+            end -= 1;
+        }
+        return OsString::from(&text[..end]);
+    }
+    #[cfg(unix)]
+    {
+        use std::os::unix::ffi::OsStrExt;
+        OsStr::from_bytes(&name.as_bytes()[..MAX_NAME_IN_TEMPORARY]).to_owned()
+    }
+    #[cfg(not(unix))]
+    {
+        OsString::from(name.to_string_lossy().chars().take(50).collect::<String>())
+    }
 }
 
 /// Follows symbolic links from `path` to the file that would be written.
@@ -525,6 +556,16 @@ fn restore_previous(parent: &Path, name: &OsStr, target: &Path) -> io::Result<()
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_long_name_is_cut_in_its_temporaries_at_a_character_boundary() {
+        let long = "é".repeat(120);
+        let prefix = temporary_prefix(OsStr::new(&long));
+        let text = prefix.to_str().unwrap();
+        assert!(text.len() <= MAX_NAME_IN_TEMPORARY + 2, "{}", text.len());
+        assert!(long.starts_with(&text[1..text.len() - 1]));
+        assert_eq!(temporary_prefix(OsStr::new("e.json")), ".e.json.");
+    }
 
     #[test]
     fn the_owner_of_a_temporary_is_read_from_its_name() {

@@ -394,3 +394,26 @@ fn a_committed_directory_keeps_the_permissions_of_the_previous_one() {
     assert_eq!(mode, 0o750);
     fs::remove_dir_all(&root).unwrap();
 }
+
+/// Issue 47: output names of 240 bytes and more failed in every writer (the
+/// temporary's name was longer than the file system allows).
+#[test]
+fn names_up_to_the_file_systems_limit_can_be_written() {
+    let root = scratch();
+    let name = format!("{}.json", "n".repeat(250));
+    assert_eq!(name.len(), 255);
+    let path = root.join(&name);
+    output::write(&path, b"old").unwrap();
+    output::write(&path, b"new").unwrap();
+    assert_eq!(fs::read(&path).unwrap(), b"new");
+    assert_eq!(names(&root), [name]);
+    let out = root.join("d".repeat(255));
+    for text in ["old", "new"] {
+        let staging = Staging::new(&out).unwrap();
+        fs::write(staging.path().join("REPORT.md"), text).unwrap();
+        staging.commit(&[]).unwrap();
+    }
+    assert_eq!(fs::read_to_string(out.join("REPORT.md")).unwrap(), "new");
+    assert_eq!(names(&root).len(), 2);
+    fs::remove_dir_all(&root).unwrap();
+}
