@@ -693,3 +693,50 @@ fn plan_refuses_a_bound_with_min_above_max_and_touches_no_output() {
         "previous"
     );
 }
+
+/// Issue 47: 10^4 vehicles x 10^6 steps passed both bounds and ran on; the rows
+/// (one per vehicle and step) are bounded together, before the output is touched.
+#[test]
+fn too_many_traffic_rows_are_refused_before_the_output_is_touched() {
+    let dir = scratch("rows");
+    std::fs::write(dir.join("existing.csv"), "precious\n").unwrap();
+    let text = read("configs/platoon.toml");
+    for (vehicles, duration, needles) in [
+        (
+            "vehicles = 10",
+            "100000",
+            ["1000000 steps of 10 vehicles", "10000010 rows"],
+        ),
+        (
+            "vehicles = 10000",
+            "100",
+            ["1000 steps of 10000 vehicles", "10010000 rows"],
+        ),
+    ] {
+        // Room on the road for 10^4 vehicles 40 m apart.
+        let config = (text.replacen("vehicles = 10", vehicles, 1))
+            .replacen("leader_start_s_m = 600.0", "leader_start_s_m = 500000.0", 1)
+            .replacen("length_m = 1000.0", "length_m = 600000.0", 1);
+        std::fs::write(dir.join("platoon.toml"), config).unwrap();
+        let output = palc(
+            &[
+                "traffic",
+                "simulate",
+                "--config",
+                "platoon.toml",
+                "--duration",
+                duration,
+                "--dt",
+                "0.1",
+                "--out",
+                "existing.csv",
+            ],
+            &dir,
+        );
+        fails_with(&output, &[needles[0], needles[1], "at most 10000000 rows"]);
+    }
+    assert_eq!(
+        std::fs::read_to_string(dir.join("existing.csv")).unwrap(),
+        "precious\n"
+    );
+}

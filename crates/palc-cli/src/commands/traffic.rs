@@ -60,6 +60,11 @@ enum Format {
 /// fill the disk or the memory (a row per vehicle and step is held until the file is written).
 const MAX_STEPS: f64 = 1e6;
 
+/// Largest number of rows one run may hold (a row per vehicle and step), as many
+/// as a samples CSV may have: 10^4 vehicles pass their bound and 10^6 steps
+/// theirs, but not both at once.
+const MAX_ROWS: f64 = 1e7;
+
 pub fn run(args: TrafficArgs) -> anyhow::Result<()> {
     match args.command {
         TrafficCommand::Simulate(args) => simulate(&args),
@@ -89,6 +94,13 @@ fn simulate(args: &SimulateArgs) -> anyhow::Result<()> {
     if !valid {
         bail!(
             "--duration / --dt = {steps} steps is out of range: at most {MAX_STEPS} steps with dt above 0 s"
+        );
+    }
+    let vehicles = scene.vehicles().len();
+    let row_count = (steps + 1.0) * vehicles as f64;
+    if row_count > MAX_ROWS {
+        bail!(
+            "--duration / --dt = {steps} steps of {vehicles} vehicles make {row_count} rows (one per vehicle and step, the start included): at most {MAX_ROWS} rows"
         );
     }
     let mut rows = Vec::new();
