@@ -6,7 +6,7 @@ the steps of the search window) and asks for the lane change it expects, a
 :class:`LaneChange` dict. The expected states keep the lane-keeping motion of the
 scene and move laterally along a quintic (minimum-jerk) profile; the driver takes
 over when a plan strays further than the run's ``planning.takeover_threshold_m``
-from them. An exception raised by the driver stops the run and reaches the caller
+from them, or by its own rule if it overrides :meth:`User.takes_over`. An exception raised by the driver stops the run and reaches the caller
 as itself, with its traceback.
 """
 
@@ -80,3 +80,13 @@ class User:
     def next(self, scene: Scene) -> LaneChange:
         """The lane change of the next drive; the nominal one unless overridden."""
         return self.nominal(scene)
+
+    def takes_over(
+        self, step: int, ego: Dict[str, float], expected_l: float, seen: Dict[str, float]
+    ) -> bool:
+        """Whether the driver takes over at ``step`` of a drive, the ego at ``ego``
+        (``s``, ``v``, ``l``, ``phi``) where it expected ``expected_l``, seeing
+        ``seen`` (the keys of ``Scene["situations"]`` at this step). Called only when
+        a subclass overrides it; otherwise the loop applies the run's deviation rule
+        (``planning.takeover_threshold_m``) itself, and this default answers no."""
+        return False

@@ -115,9 +115,11 @@ def test_a_bad_config_is_refused_and_leaves_the_previous_results(tmp_path: Path)
         palc.evaluate(bad, out=out, jobs=1)
     assert "bogus" in str(caught.value)
     assert (out / "REPORT.md").read_text() == "previous"
-    with pytest.raises(palc.ConfigError) as caught:
-        palc.evaluate(small_config(tmp_path), out=out, jobs=0)
-    assert caught.value.field == "jobs"
+    for jobs in (0, 100_000):
+        with pytest.raises(palc.ConfigError) as caught:
+            palc.evaluate(small_config(tmp_path), out=out, jobs=jobs)
+        assert caught.value.field == "jobs"
+    assert (out / "REPORT.md").read_text() == "previous"
 
 
 def test_an_exception_in_the_progress_callback_is_raised(tmp_path: Path) -> None:

@@ -92,3 +92,26 @@ def test_a_bad_answer_names_the_field() -> None:
     with pytest.raises(palc.ConfigError) as caught:
         palc.learn(config(), user=Misspelt())
     assert "duration" in str(caught.value)
+
+
+def test_a_driver_that_never_takes_over_is_personalized_at_once() -> None:
+    class Lenient(Neutral):
+        def takes_over(self, step: int, ego: dict, expected_l: float, seen: dict) -> bool:
+            return False
+
+    result = palc.learn(config(), user=Lenient())
+    assert result.outcome == "personalized"
+    assert result.takeovers == 0
+
+
+def test_an_exception_in_takes_over_surfaces_with_its_traceback() -> None:
+    class Nervous(Neutral):
+        def takes_over(self, step: int, ego: dict, expected_l: float, seen: dict) -> bool:
+            raise ValueError(f"no rule for step {step}")
+
+    with pytest.raises(ValueError, match="no rule for step") as caught:
+        palc.learn(config(), user=Nervous())
+    assert any(frame.name == "takes_over" for frame in traceback.extract_tb(caught.value.__traceback__))
+    learning = palc.LearningLoop(config(), user=Nervous())
+    with pytest.raises(ValueError, match="no rule for step"):
+        next(learning)

@@ -92,6 +92,16 @@ fn classify(error: &EvalError) -> Raise {
             ..Raise::field("ConfigError", field.clone())
         },
         EvalError::Unknown { field, .. } => Raise::field("ConfigError", field.clone()),
+        // An option of the command line is a keyword argument here (`--jobs`: `jobs`).
+        EvalError::InvalidOption {
+            option,
+            value,
+            bound,
+        } => Raise {
+            value: Some(errors::Value::Text(value.clone())),
+            bound: Some(bound.clone()),
+            ..Raise::field("ConfigError", option.trim_start_matches('-'))
+        },
         EvalError::Harness(e) | EvalError::Run { source: e, .. } => errors::classify_harness(e),
         _ => Raise::class("PalcError"),
     }

@@ -310,9 +310,30 @@ fn loop_for(
 /// The exception of a harness error, or the Python driver's own exception that
 /// caused it (with its traceback).
 fn harness_or_raised(py: Python<'_>, error: &HarnessError, raised: &Raised) -> PyErr {
-    match raised.lock().ok().and_then(|mut slot| slot.take()) {
+    match take(raised) {
         Some(original) => original,
         None => errors::harness(py, error),
+    }
+}
+
+/// The exception a Python driver raised, if it did.
+fn take(raised: &Raised) -> Option<PyErr> {
+    raised.lock().ok().and_then(|mut slot| slot.take())
+}
+
+/// The result of a run, or the Python driver's exception if it raised on the way
+/// (from `takes_over`, which cannot stop the run itself).
+fn finish(
+    py: Python<'_>,
+    result: Result<RunResult, HarnessError>,
+    raised: &Raised,
+) -> PyResult<LearnResult> {
+    if let Some(original) = take(raised) {
+        return Err(original);
+    }
+    match result {
+        Ok(inner) => Ok(LearnResult { inner }),
+        Err(e) => Err(errors::harness(py, &e)),
     }
 }
 
@@ -332,10 +353,8 @@ pub fn learn(
         let raised = Raised::default();
         let experience = experience.map(|e| &e.inner);
         let learning = loop_for(py, &config.inner, experience, user, &raised)?;
-        match py.detach(|| learning.run(&mut NoObserver)) {
-            Ok(inner) => Ok(LearnResult { inner }),
-            Err(e) => Err(harness_or_raised(py, &e, &raised)),
-        }
+        let result = py.detach(|| learning.run(&mut NoObserver));
+        finish(py, result, &raised)
     })
 }
 
@@ -418,9 +437,12 @@ impl LearningLoop {
                     return Ok(None);
                 }
                 let stepped = py.detach(|| learning.step(&mut NoObserver).cloned());
+                if let Some(original) = take(&self.raised) {
+                    return Err(original);
+                }
                 match stepped {
                     Ok(r) => record(py, &r).map(Some),
-                    Err(e) => Err(harness_or_raised(py, &e, &self.raised)),
+                    Err(e) => Err(errors::harness(py, &e)),
                 }
             })
         })
@@ -446,10 +468,8 @@ impl LearningLoop {
             let Some(learning) = learning else {
                 return Err(unavailable(py, "the learning loop is finished"));
             };
-            match py.detach(|| learning.run(&mut NoObserver)) {
-                Ok(inner) => Ok(LearnResult { inner }),
-                Err(e) => Err(harness_or_raised(py, &e, &self.raised)),
-            }
+            let result = py.detach(|| learning.run(&mut NoObserver));
+            finish(py, result, &self.raised)
         })
     }
 

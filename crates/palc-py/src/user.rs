@@ -8,13 +8,18 @@
 //! laterally along a quintic, and the user takes over past the run's deviation
 //! threshold (`planning.takeover_threshold_m`).
 //!
-//! A Python exception inside the driver stops the run as a `UserError::Failed`; the
-//! exception itself is kept and raised again to the caller with its own traceback.
+//! A driver may also define `takes_over(step, ego, expected_l, seen)`, called at
+//! every step of a drive, to take over by its own rule instead of the deviation's.
+//!
+//! A Python exception inside the driver stops the run as a `UserError::Failed` (in
+//! `takes_over`, the deviation rule judges the rest of the run); the exception
+//! itself is kept and raised again to the caller with its own traceback.
 
 use std::sync::{Arc, Mutex};
 
 use palc_harness::user::{
-    Expectation, ExpectedLaneChange, SpeedRule, TakeoverRule, User, UserError, UserScene,
+    Expectation, ExpectedLaneChange, Situation, SpeedRule, TakeoverCause, TakeoverRule, User,
+    UserError, UserScene,
 };
 use palc_planner::State;
 use pyo3::prelude::*;
@@ -56,6 +61,22 @@ pub(crate) struct PythonUser {
     name: String,
     deviation_m: f64,
     raised: Raised,
+    /// Whether the object overrides `takes_over` (else the deviation rule decides).
+    own_takeover: bool,
+}
+
+/// Whether `object`'s class defines `method` itself rather than inheriting
+/// `palc.User`'s.
+fn overrides(py: Python<'_>, object: &Bound<'_, PyAny>, method: &str) -> bool {
+    let base = py
+        .import("palc._user")
+        .and_then(|m| m.getattr("User"))
+        .and_then(|user| user.getattr(method));
+    match (object.get_type().getattr(method), base) {
+        (Ok(own), Ok(base)) => !own.is(&base),
+        (Ok(_), Err(_)) => true,
+        _ => false,
+    }
 }
 
 impl PythonUser {
@@ -68,11 +89,13 @@ impl PythonUser {
             .and_then(|n| n.extract::<String>())
             .or_else(|_| object.bind(py).get_type().name().map(|n| n.to_string()))
             .unwrap_or_else(|_| "python".to_owned());
+        let own_takeover = overrides(py, object.bind(py), "takes_over");
         PythonUser {
             object,
             name,
             deviation_m,
             raised,
+            own_takeover,
         }
     }
 
@@ -112,6 +135,75 @@ impl User for PythonUser {
     fn next(&mut self, scene: &UserScene<'_>) -> Result<Expectation, UserError> {
         self.call("next", scene)
     }
+
+    /// The Python driver's `takes_over(step, ego, expected_l, seen)` if it defines
+    /// one (a true answer is reported as a deviation takeover), else the deviation
+    /// rule. Once the driver has raised, it is not called again and the run's caller
+    /// gets the exception.
+    fn takes_over(
+        &self,
+        expectation: &Expectation,
+        step: usize,
+        ego: &State,
+        seen: &Situation,
+    ) -> Option<TakeoverCause> {
+        let expected_l = expectation.states.get(step).map_or(ego.l, |x| x.l);
+        let rule = || {
+            let lane_change = &expectation.lane_change;
+            (expectation.takeover).judge(
+                ego.l,
+                expected_l,
+                (lane_change.from_l, lane_change.to_l),
+                seen,
+            )
+        };
+        if !self.own_takeover || self.raised.lock().map_or(true, |r| r.is_some()) {
+            return rule();
+        }
+        Python::attach(|py| {
+            let answer = (|| -> PyResult<bool> {
+                let state = PyDict::new(py);
+                for (key, value) in [("s", ego.s), ("v", ego.v), ("l", ego.l), ("phi", ego.phi)] {
+                    state.set_item(key, value)?;
+                }
+                let situation = situation_dict(py, seen)?;
+                let args = (step, state, expected_l, situation);
+                self.object
+                    .bind(py)
+                    .call_method1("takes_over", args)?
+                    .is_truthy()
+            })();
+            match answer {
+                Ok(true) => Some(TakeoverCause::Deviation),
+                Ok(false) => None,
+                Err(error) => {
+                    if let Ok(mut slot) = self.raised.lock() {
+                        slot.get_or_insert(error);
+                    }
+                    rule()
+                }
+            }
+        })
+    }
+}
+
+/// One step's situation as a dict of numbers (NaN where there is no vehicle).
+fn situation_dict<'py>(py: Python<'py>, x: &Situation) -> PyResult<Bound<'py, PyDict>> {
+    let dict = PyDict::new(py);
+    let or_nan = |x: Option<f64>| x.unwrap_or(f64::NAN);
+    for (key, value) in [
+        ("time_headway_s", x.time_headway_s),
+        ("preceding_gap_m", x.preceding_gap_m),
+        ("preceding_speed", or_nan(x.preceding_speed)),
+        ("target_lead_gap_m", or_nan(x.target_lead_gap_m)),
+        ("target_lag_gap_m", or_nan(x.target_lag_gap_m)),
+        ("ego_speed", x.ego_speed),
+        ("target_lead_speed", or_nan(x.target_lead_speed)),
+        ("target_lag_speed", or_nan(x.target_lag_speed)),
+    ] {
+        dict.set_item(key, value)?;
+    }
+    Ok(dict)
 }
 
 /// The scene as a dict: `dt`, `set_speed`, `target_l`, `lane_keeping` (n, 2) of
@@ -127,7 +219,7 @@ fn scene_dict<'py>(py: Python<'py>, scene: &UserScene<'_>) -> PyResult<Bound<'py
     dict.set_item("lane_keeping", to_matrix(py, keeping.len(), 2, values)?)?;
     let situations = PyDict::new(py);
     let s = scene.situations;
-    let column = |f: &dyn Fn(&palc_harness::user::Situation) -> f64| s.iter().map(f).collect();
+    let column = |f: &dyn Fn(&Situation) -> f64| s.iter().map(f).collect();
     let or_nan = |x: Option<f64>| x.unwrap_or(f64::NAN);
     let columns: [(&str, Vec<f64>); 8] = [
         ("time_headway_s", column(&|x| x.time_headway_s)),
