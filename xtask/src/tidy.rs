@@ -198,7 +198,7 @@ const DEPENDENCY_RULES: &[(&str, &[&str], bool)] = &[
         &["palc-zone-filter", "palc-planner"],
         true,
     ),
-    ("palc-user", &["palc-planner"], true),
+    ("palc-user", &["palc-planner", "palc-traffic"], true),
     (
         "palc-harness",
         &[

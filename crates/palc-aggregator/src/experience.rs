@@ -9,7 +9,9 @@ use serde::{Deserialize, Serialize};
 use crate::{AggregatorError, ApprenticeshipState, Onset, resample_weights};
 
 /// The experience format version this build writes and the newest it reads.
-pub const EXPERIENCE_FORMAT_VERSION: u32 = 1;
+/// Version 2 adds the scene each onset was observed in ([`crate::SceneSteps`]);
+/// version-1 files load with none.
+pub const EXPERIENCE_FORMAT_VERSION: u32 = 2;
 /// Bounds of an experience's step `metadata.dt` (s): the harness plans at most at
 /// 0.5 s (`planning.dt`), and a millisecond step resamples a 60 s plan into
 /// 60,000 columns, beyond the planner's horizon.

@@ -104,7 +104,7 @@ pub use experience::{
 };
 pub use expert::{ExpertGenerator, ExpertInput, ExpertKind, LessonExpert, ZoneCentreExpert};
 pub use lesson::Lesson;
-pub use onset::Onset;
+pub use onset::{Onset, SceneSteps, SeenStep};
 pub use options::{AggregatorOptions, Representation};
 pub use resample::{resample_weights, resample_weights_shifted};
 pub use rows::LearnableRows;

@@ -70,6 +70,80 @@ pub struct Onset {
     pub follower_wait_time_headway_s: Option<f64>,
     /// Lessons this onset is the mean of.
     pub observations: u64,
+    /// What the driver saw at every step of the scene (the ego keeping its
+    /// lane), so that a model of the decision is checked at every step, the
+    /// steps at which the driver did not start as much as its start. `None` in
+    /// files written before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scene: Option<SceneSteps>,
+}
+
+/// What a driver saw at each step of one scene, as plain numbers: the vehicle
+/// ahead on its own lane and the nearest vehicles ahead and behind on the target
+/// lane (palc-user's `Situation`, step by step).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneSteps {
+    /// Step (s).
+    pub dt: f64,
+    /// The ego's set speed (m/s).
+    pub set_speed_mps: f64,
+    /// One entry per step, from the start of the plan.
+    pub steps: Vec<SeenStep>,
+}
+
+/// What a driver saw at one step. Gaps are net (bumper to bumper) in metres; a
+/// missing vehicle is `None`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SeenStep {
+    /// Ego speed (m/s).
+    pub ego_speed: f64,
+    /// The vehicle ahead on the ego's lane: `(gap, speed)`.
+    pub preceding: Option<(f64, f64)>,
+    /// The target lane's leader: `(gap, speed)`.
+    pub target_lead: Option<(f64, f64)>,
+    /// The target lane's follower: `(gap, speed)`; a negative gap while alongside.
+    pub target_lag: Option<(f64, f64)>,
+    /// Under the safety layer: whether both target-lane gaps were at the safe
+    /// distance. `None` without the layer.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub safe: Option<bool>,
+}
+
+impl SceneSteps {
+    fn validate(&self, index: usize) -> Result<(), AggregatorError> {
+        let field = |name: String| format!("onsets[{index}].scene.{name}");
+        for (name, value) in [("dt", self.dt), ("set_speed_mps", self.set_speed_mps)] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(AggregatorError::NonFinite {
+                    field: field(name.to_owned()),
+                    value,
+                });
+            }
+        }
+        for (i, step) in self.steps.iter().enumerate() {
+            let pairs = [
+                ("preceding", step.preceding),
+                ("target_lead", step.target_lead),
+                ("target_lag", step.target_lag),
+            ];
+            let values = pairs
+                .iter()
+                .flat_map(|&(name, pair)| pair.map(|(gap, speed)| [(name, gap), (name, speed)]))
+                .flatten()
+                .chain(std::iter::once(("ego_speed", step.ego_speed)));
+            for (name, value) in values {
+                if !value.is_finite() {
+                    return Err(AggregatorError::NonFinite {
+                        field: field(format!("steps[{i}].{name}")),
+                        value,
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
 }
 
 impl Onset {
@@ -101,7 +175,9 @@ impl Onset {
                 }
             }
         }
-        Ok(())
+        self.scene
+            .as_ref()
+            .map_or(Ok(()), |scene| scene.validate(index))
     }
 
     /// The running mean of this onset and `other`, observed in the same scene:
@@ -148,6 +224,7 @@ impl Onset {
                 other.follower_wait_time_headway_s,
             ),
             observations: self.observations + other.observations,
+            scene: other.scene.clone().or_else(|| self.scene.clone()),
         }
     }
 }
@@ -170,6 +247,7 @@ mod tests {
             accepted_lead_time_gap_s: None,
             follower_wait_time_headway_s: None,
             observations: n,
+            scene: None,
         }
     }
 

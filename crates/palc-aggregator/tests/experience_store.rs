@@ -64,6 +64,7 @@ fn sample_experience() -> Experience {
         accepted_lead_time_gap_s: Some(1.37),
         follower_wait_time_headway_s: Some(0.88),
         observations: 2,
+        scene: None,
     }];
     experience.demonstration = Some((0..=20).map(|i| 3.5 * f64::from(i) / 20.0).collect());
     experience
@@ -210,7 +211,7 @@ fn corrupt_files_are_clear_errors() {
     let cases = [
         ("not json", "garbage".to_owned()),
         ("binary", "\u{0}\u{1}\u{2}".to_owned()),
-        ("no version", text.replace("\"format_version\": 1,", "")),
+        ("no version", text.replace("\"format_version\": 2,", "")),
         (
             "unknown field",
             text.replacen("\"metadata\": {", "\"extra\": 1, \"metadata\": {", 1),
@@ -225,7 +226,7 @@ fn corrupt_files_are_clear_errors() {
         ),
         (
             "version 0",
-            text.replacen("\"format_version\": 1", "\"format_version\": 0", 1),
+            text.replacen("\"format_version\": 2", "\"format_version\": 0", 1),
         ),
         (
             "short column",
@@ -252,7 +253,7 @@ fn newer_version_is_refused_naming_both_versions() {
     let text = fs::read_to_string(&path).unwrap();
     // A newer format may change everything else too: only the version is read.
     let newer = text
-        .replacen("\"format_version\": 1", "\"format_version\": 7", 1)
+        .replacen("\"format_version\": 2", "\"format_version\": 7", 1)
         .replacen("\"metadata\"", "\"meta_v7\"", 1);
     fs::write(&path, newer).unwrap();
     let err = Experience::load(&path).unwrap_err();
@@ -408,4 +409,55 @@ fn weights_are_usable_at_another_horizon_and_step() {
     assert!(palc_planner::check_convexity(&w).is_ok());
     assert!(experience.weights_for(0, 0.05).is_err());
     assert!(experience.weights_for(10, 0.0).is_err());
+}
+
+/// A version-1 file (no recorded scenes) still loads: its onsets carry no
+/// scene, and the start is then predicted from the onsets' own readings.
+#[test]
+fn a_version_1_file_loads_without_scenes() {
+    let dir = scratch();
+    let path = dir.join("experience.json");
+    let mut experience = sample_experience();
+    experience.onsets[0].scene = None;
+    experience.save(&path).unwrap();
+    let text = fs::read_to_string(&path).unwrap();
+    assert!(!text.contains("\"scene\""));
+    fs::write(
+        &path,
+        text.replacen("\"format_version\": 2", "\"format_version\": 1", 1),
+    )
+    .unwrap();
+    let loaded = Experience::load(&path).unwrap();
+    assert_eq!(loaded, experience);
+    fs::remove_dir_all(&dir).unwrap();
+}
+
+/// An onset's recorded scene round-trips bit for bit, and a non-finite value in
+/// it is refused naming the step.
+#[test]
+fn a_recorded_scene_round_trips_and_is_checked() {
+    let dir = scratch();
+    let path = dir.join("experience.json");
+    let mut experience = sample_experience();
+    let step = |i: u32| palc_aggregator::SeenStep {
+        ego_speed: 20.1,
+        preceding: Some((44.0 - 0.1 * f64::from(i), 17.9)),
+        target_lead: Some((6.0 + 0.3 * f64::from(i), 17.9)),
+        target_lag: if i < 3 { None } else { Some((-1.5, 17.9)) },
+        safe: None,
+    };
+    experience.onsets[0].scene = Some(palc_aggregator::SceneSteps {
+        dt: 0.1,
+        set_speed_mps: 20.1,
+        steps: (0..6).map(step).collect(),
+    });
+    experience.save(&path).unwrap();
+    assert_eq!(Experience::load(&path).unwrap(), experience);
+    experience.onsets[0].scene.as_mut().unwrap().steps[4].ego_speed = f64::NAN;
+    let message = experience.validate().unwrap_err().to_string();
+    assert!(
+        message.contains("onsets[0].scene.steps[4].ego_speed"),
+        "{message}"
+    );
+    fs::remove_dir_all(&dir).unwrap();
 }

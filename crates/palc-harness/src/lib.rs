@@ -38,6 +38,7 @@ mod carry;
 pub mod closed_loop;
 pub mod config;
 mod drive;
+pub mod driver;
 mod error;
 mod guard;
 mod learning_loop;

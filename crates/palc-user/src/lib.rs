@@ -44,6 +44,7 @@ mod scene;
 mod simulated;
 mod situation;
 mod spread;
+mod start;
 mod style;
 
 use palc_planner::State;
@@ -70,6 +71,7 @@ pub use scene::{SafeDistance, UserScene};
 pub use simulated::{MAX_DRAWS, SimulatedUser};
 pub use situation::Situation;
 pub use spread::{Draw, MAX_ABSOLUTE_SPREAD, MAX_RELATIVE_SPREAD, ParameterSpread, Spread};
+pub use start::{NoStart, StartModel};
 pub use style::{MAX_GAP_ACCEPTANCE_S, Style, StylePreset};
 
 /// A user of the lesson-learning loop: what it expects, when it takes over, how

@@ -15,6 +15,7 @@ use crate::profile::TABLE_END_TOLERANCE_M;
 use crate::scene::UserScene;
 use crate::situation::Situation;
 use crate::spread::Spread;
+use crate::start::{NoStart, StartModel};
 use crate::style::Style;
 
 /// Most draws of one lane change's parameters (a draw whose lane change fails the
@@ -98,34 +99,7 @@ impl SimulatedUser {
         let situations = scene.situations;
         let dt = scene.dt;
         let window = scene.window();
-        let decision_step = situations
-            .iter()
-            .position(|s| {
-                family
-                    .start
-                    .decides(s, style.time_headway_s, scene.set_speed)
-            })
-            .ok_or_else(|| {
-                refuse(UserRefusal::StartRuleNeverMet {
-                    rule: family.start.name().to_owned(),
-                    window_s: window as f64 * dt,
-                })
-            })?;
-        if decision_step == 0 {
-            return Err(refuse(UserRefusal::StartRuleMetAtTrigger {
-                rule: family.start.name().to_owned(),
-                time_headway_s: situations[0].time_headway_s,
-            }));
-        }
-        let accepting = Style {
-            min_lead_gap_s: family.min_lead_gap_s.unwrap_or(style.min_lead_gap_s),
-            min_lag_gap_s: family.min_lag_gap_s.unwrap_or(style.min_lag_gap_s),
-            ..*style
-        };
-        // The reaction delay in whole steps, rounding up (1e-9 absorbs a delay
-        // that is a multiple of the step up to rounding).
-        let reaction_steps = (family.reaction_s / dt - 1e-9).ceil().max(0.0) as usize;
-        let earliest = decision_step + reaction_steps;
+        let model = StartModel::of(style, family);
         let duration_s = family
             .profile
             .own_duration_s()
@@ -164,14 +138,26 @@ impl SimulatedUser {
                 safe_gaps.target_gaps_safe(&situations[j]) && safe_gaps.target_gaps_safe(&seen)
             })
         };
-        let start_step = (earliest..=window)
-            .find(|&i| accepting.accepts(&situations[i]) && safe(i))
-            .ok_or_else(|| {
-                refuse(UserRefusal::GapsNeverAcceptable {
-                    min_lead_gap_s: accepting.min_lead_gap_s,
-                    min_lag_gap_s: accepting.min_lag_gap_s,
-                    safe_distance: scene.safe_gaps.is_some(),
-                    decision_step,
+        let (decision_step, start_step) = model
+            .start_step(&situations[..=window], dt, scene.set_speed, safe)
+            .map_err(|no_start| {
+                refuse(match no_start {
+                    NoStart::NeverDecides => UserRefusal::StartRuleNeverMet {
+                        rule: family.start.name().to_owned(),
+                        window_s: window as f64 * dt,
+                    },
+                    NoStart::DecidedAtFirstStep => UserRefusal::StartRuleMetAtTrigger {
+                        rule: family.start.name().to_owned(),
+                        time_headway_s: situations[0].time_headway_s,
+                    },
+                    NoStart::GapsNeverAcceptable { decision_step } => {
+                        UserRefusal::GapsNeverAcceptable {
+                            min_lead_gap_s: model.min_lead_gap_s,
+                            min_lag_gap_s: model.min_lag_gap_s,
+                            safe_distance: scene.safe_gaps.is_some(),
+                            decision_step,
+                        }
+                    }
                 })
             })?;
         let lane_change = ExpectedLaneChange {

@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use clap::Args;
 use palc_aggregator::{Experience, output};
+use palc_harness::driver::DriverEstimate;
 use palc_harness::{
     CellChoice, LaneChangeRecord, LearnConfig, LessonEvent, Method, Observer, RunSummary,
     UserConfig, config::UserStyle, run,
@@ -171,6 +172,10 @@ pub fn run_learn(args: LearnArgs) -> anyhow::Result<()> {
     };
     say!("{} ({} method)", config.label(), config.method.name());
     let result = run(&config, experience.as_ref(), &mut Printer)?;
+    let duration_s = config.planning.standard_alc.lane_change_duration_s;
+    if let Some(estimate) = DriverEstimate::from_onsets(&result.experience.onsets, duration_s) {
+        say!("the driver, as palc believes: {}", estimate.describe());
+    }
     if let Some(path) = &args.save_experience {
         result
             .experience

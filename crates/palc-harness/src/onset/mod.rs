@@ -16,7 +16,8 @@
 //!
 //! The relative state at that start ([`Onset`]: time headway, time to collision
 //! and gap to the vehicle ahead, and a target-lane gap when it held the user back)
-//! is what carries. In a new scene the start is predicted with the structure of a
+//! is what carries, recorded with what the user saw at every step of the scene
+//! (what the driver estimate of `crate::driver` reads). In a new scene the start is predicted with the structure of a
 //! gap-acceptance driver: the user decides when the decision feature falls to
 //! the learned threshold, then starts at the first step from there where the
 //! target-lane gaps are at least the learned ones ([`predicted_start_s`]).

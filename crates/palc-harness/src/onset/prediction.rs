@@ -103,6 +103,7 @@ pub(crate) fn onset_at(setup: &Setup, start_s: f64, before: &[Onset]) -> Option<
         accepted_lead_time_gap_s: lead_time_gap(&setup.situations[step]).filter(|g| g.is_finite()),
         follower_wait_time_headway_s: None,
         observations: 1,
+        scene: Some(crate::driver::scene_steps(setup)),
     };
     if onset.lag_time_gap_s.is_some() {
         onset.time_headway_ceiling_s = last_open_step_before_alongside(setup, step)
@@ -528,6 +529,7 @@ mod tests {
             accepted_lead_time_gap_s: None,
             follower_wait_time_headway_s: None,
             observations: 1,
+            scene: None,
         }
     }
 

@@ -1,0 +1,558 @@
+//! The posterior over start models and the start it predicts in a new scene.
+
+use palc_aggregator::Onset;
+use palc_user::{Situation, StartModel};
+
+use super::prior::{self, Cue, LAG_GAPS_S, LEAD_GAPS_S, MISFIT_SDS, OBSERVATION_SD_S, REACTIONS_S};
+use super::scene::situations;
+
+/// A step index that means "never starts".
+const NEVER: u32 = u32::MAX;
+
+/// The grid of start models: every threshold of every cue, crossed with every
+/// reaction and pair of accepted gaps. Hypothesis `h` is threshold
+/// `h % thresholds` of combination `h / thresholds`.
+#[derive(Debug, Clone)]
+struct Grid {
+    /// Each cue with the index of its first threshold and its thresholds.
+    cues: Vec<(Cue, usize, Vec<f64>)>,
+    /// All thresholds, of every cue.
+    thresholds: usize,
+}
+
+impl Grid {
+    fn new() -> Grid {
+        let mut offset = 0;
+        let cues = (Cue::ALL.iter())
+            .map(|&cue| {
+                let thresholds = cue.thresholds();
+                let first = offset;
+                offset += thresholds.len();
+                (cue, first, thresholds)
+            })
+            .collect();
+        Grid {
+            cues,
+            thresholds: offset,
+        }
+    }
+
+    fn combinations() -> usize {
+        REACTIONS_S.len() * LEAD_GAPS_S.len() * LAG_GAPS_S.len()
+    }
+
+    fn len(&self) -> usize {
+        self.thresholds * Grid::combinations()
+    }
+
+    /// The cue and threshold of threshold index `t` (below `self.thresholds`).
+    fn threshold(&self, t: usize) -> (Cue, f64) {
+        let mut rest = t;
+        for (cue, _, thresholds) in &self.cues {
+            if rest < thresholds.len() {
+                return (*cue, thresholds[rest]);
+            }
+            rest -= thresholds.len();
+        }
+        // Past the last threshold: the last of the last cue.
+        let (cue, _, thresholds) = &self.cues[self.cues.len() - 1];
+        (*cue, thresholds[thresholds.len() - 1])
+    }
+
+    /// The start model of hypothesis `h`.
+    fn model(&self, h: usize) -> StartModel {
+        let (cue, threshold) = self.threshold(h % self.thresholds);
+        let (rule, time_headway_s) = cue.rule(threshold);
+        let (reaction_s, min_lead_gap_s, min_lag_gap_s) = combination(h / self.thresholds);
+        StartModel {
+            rule,
+            time_headway_s,
+            reaction_s,
+            min_lead_gap_s,
+            min_lag_gap_s,
+        }
+    }
+
+    /// The start step of every hypothesis in a scene ([`NEVER`] for none): the
+    /// fast form of [`StartModel::start_step`] (a test checks the two agree),
+    /// sharing each threshold's decision step across the combinations and each
+    /// pair of gaps' next acceptable step across the reactions. A model that has
+    /// decided at the scene's first step never starts in it: its driver would
+    /// have changed lanes before the system planned (palc-user refuses such a
+    /// scene for a simulated user).
+    fn starts(&self, scene: &SceneView<'_>) -> Vec<u32> {
+        let n = scene.situations.len();
+        let mut decision = vec![NEVER; self.thresholds];
+        for (cue, first, thresholds) in &self.cues {
+            let mut running = f64::NEG_INFINITY;
+            let most_urgent: Vec<f64> = (scene.situations.iter())
+                .map(|s| {
+                    running = running.max(cue.urgency(s, scene.set_speed_mps));
+                    running
+                })
+                .collect();
+            for (j, &threshold) in thresholds.iter().enumerate() {
+                let key = cue.key(threshold);
+                let step = most_urgent.partition_point(|&u| u < key);
+                if step > 0 && step < n {
+                    decision[first + j] = step as u32;
+                }
+            }
+        }
+        let mut starts = vec![NEVER; self.len()];
+        let mut next = vec![NEVER; n + 1];
+        for (lead_index, &lead) in LEAD_GAPS_S.iter().enumerate() {
+            for (lag_index, &lag) in LAG_GAPS_S.iter().enumerate() {
+                let gaps = StartModel {
+                    min_lead_gap_s: lead,
+                    min_lag_gap_s: lag,
+                    ..self.model(0)
+                };
+                for i in (0..n).rev() {
+                    let open = gaps.accepts(&scene.situations[i]) && scene.safe_through[i];
+                    next[i] = if open { i as u32 } else { next[i + 1] };
+                }
+                for (reaction_index, &reaction_s) in REACTIONS_S.iter().enumerate() {
+                    let reaction = StartModel { reaction_s, ..gaps }.reaction_steps(scene.dt);
+                    let c = combination_index(reaction_index, lead_index, lag_index);
+                    let out = &mut starts[c * self.thresholds..(c + 1) * self.thresholds];
+                    for (start, &decided) in out.iter_mut().zip(&decision) {
+                        if decided != NEVER {
+                            *start = next[(decided as usize + reaction).min(n)];
+                        }
+                    }
+                }
+            }
+        }
+        starts
+    }
+}
+
+/// The reaction and gaps of combination `c`.
+fn combination(c: usize) -> (f64, f64, f64) {
+    let lag = c % LAG_GAPS_S.len();
+    let lead = (c / LAG_GAPS_S.len()) % LEAD_GAPS_S.len();
+    let reaction = c / (LAG_GAPS_S.len() * LEAD_GAPS_S.len());
+    (REACTIONS_S[reaction], LEAD_GAPS_S[lead], LAG_GAPS_S[lag])
+}
+
+fn combination_index(reaction: usize, lead: usize, lag: usize) -> usize {
+    (reaction * LEAD_GAPS_S.len() + lead) * LAG_GAPS_S.len() + lag
+}
+
+/// A scene as the estimate reads it.
+struct SceneView<'a> {
+    situations: &'a [Situation],
+    dt: f64,
+    set_speed_mps: f64,
+    /// Whether a lane change started at each step keeps the safety layer's
+    /// distance throughout (all `true` without the layer).
+    safe_through: Vec<bool>,
+}
+
+impl<'a> SceneView<'a> {
+    /// `safe` per step (`None` without the safety layer), a lane change lasting
+    /// `duration_s`.
+    fn new(
+        situations: &'a [Situation],
+        dt: f64,
+        set_speed_mps: f64,
+        safe: Option<&[bool]>,
+        duration_s: f64,
+    ) -> SceneView<'a> {
+        let n = situations.len();
+        let steps = (duration_s / dt).ceil().max(0.0) as usize;
+        let safe_through = match safe {
+            None => vec![true; n],
+            Some(safe) => (0..n)
+                .map(|i| {
+                    safe[i..=i.saturating_add(steps).min(n - 1)]
+                        .iter()
+                        .all(|&s| s)
+                })
+                .collect(),
+        };
+        SceneView {
+            situations,
+            dt,
+            set_speed_mps,
+            safe_through,
+        }
+    }
+}
+
+/// What the estimate predicts in a scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Prediction {
+    /// The start (s after the start of the plan) with the largest posterior mass.
+    Start(f64),
+    /// Most of the posterior never starts in this scene.
+    NoStart,
+    /// No start model explains every scene the driver was seen in.
+    OutsideModel,
+}
+
+/// The posterior over start models, given the scenes a driver started in.
+#[derive(Debug, Clone)]
+pub struct DriverEstimate {
+    grid: Grid,
+    /// Unnormalized log posterior per hypothesis.
+    log_posterior: Vec<f64>,
+    /// The smallest, over hypotheses, of the largest distance (s) between a
+    /// scene's observed start and the hypothesis's.
+    closest_s: f64,
+    /// Scenes observed.
+    scenes: usize,
+}
+
+impl DriverEstimate {
+    /// The estimate from the onsets that recorded their scene; `None` when none
+    /// did. Under the safety layer a start must keep the safe distance for a
+    /// lane change of `duration_s`.
+    pub fn from_onsets(onsets: &[Onset], duration_s: f64) -> Option<DriverEstimate> {
+        let grid = Grid::new();
+        let mut log_posterior = prior(&grid);
+        let mut worst = vec![0.0f64; grid.len()];
+        let mut scenes = 0;
+        for onset in onsets {
+            let Some(scene) = &onset.scene else { continue };
+            let seen = situations(scene);
+            let safe: Option<Vec<bool>> = scene.steps.iter().map(|s| s.safe).collect();
+            let view = SceneView::new(
+                &seen,
+                scene.dt,
+                scene.set_speed_mps,
+                safe.as_deref(),
+                duration_s,
+            );
+            let starts = grid.starts(&view);
+            for ((lp, far), &start) in log_posterior.iter_mut().zip(&mut worst).zip(&starts) {
+                let error = if start == NEVER {
+                    f64::INFINITY
+                } else {
+                    (f64::from(start) * scene.dt - onset.time_s).abs()
+                };
+                *far = far.max(error);
+                *lp -= 0.5 * (error / OBSERVATION_SD_S).powi(2);
+            }
+            scenes += 1;
+        }
+        if scenes == 0 {
+            return None;
+        }
+        let closest_s = worst.iter().copied().fold(f64::INFINITY, f64::min);
+        Some(DriverEstimate {
+            grid,
+            log_posterior,
+            closest_s,
+            scenes,
+        })
+    }
+
+    /// Whether no start model predicts every observed start within
+    /// [`MISFIT_SDS`] standard deviations.
+    pub fn outside_model(&self) -> bool {
+        // `closest_s` is infinite, never NaN, when no model starts in a scene.
+        self.closest_s > MISFIT_SDS * OBSERVATION_SD_S
+    }
+
+    /// Scenes the estimate has seen.
+    pub fn scenes(&self) -> usize {
+        self.scenes
+    }
+
+    /// The posterior's most probable start model: among equals, the first of
+    /// the grid, which is the least demanding (shortest reaction, smallest
+    /// gaps) and, within a cue, the one that decides latest, at the start
+    /// itself unless a scene showed a wait.
+    pub fn most_probable(&self) -> StartModel {
+        self.grid.model(self.most_probable_index())
+    }
+
+    fn most_probable_index(&self) -> usize {
+        let (h, _) = (self.log_posterior.iter().enumerate()).fold(
+            (0, f64::NEG_INFINITY),
+            |best, (h, &lp)| {
+                if lp > best.1 + 1e-12 { (h, lp) } else { best }
+            },
+        );
+        h
+    }
+
+    /// What the estimate believes, in one line: the most probable start model,
+    /// the posterior mass of its cue and the scenes seen; or that the driver is
+    /// outside the model, with the closest any model came.
+    pub fn describe(&self) -> String {
+        if self.outside_model() {
+            return format!(
+                "outside the model: no start model within {:.2} s of every start \
+                 (scenes seen: {}, closest {:.2} s)",
+                MISFIT_SDS * OBSERVATION_SD_S,
+                self.scenes,
+                self.closest_s
+            );
+        }
+        let h = self.most_probable_index();
+        let (cue, threshold) = self.grid.threshold(h % self.grid.thresholds);
+        let model = self.grid.model(h);
+        let unit = match cue {
+            Cue::TimeHeadway | Cue::TimeToCollision => "s",
+            Cue::DistanceGap => "m",
+            Cue::Incentive => "m/s²",
+        };
+        let mass = (self.cue_masses().into_iter())
+            .find(|(name, _)| *name == cue.name())
+            .map_or(0.0, |(_, mass)| mass);
+        format!(
+            "decides on the {} at {threshold:.2} {unit} (posterior mass of the cue {mass:.2}), \
+             reacts in {:.1} s, accepts lead gaps from {:.1} s and lag gaps from {:.2} s \
+             (scenes seen: {})",
+            cue.name(),
+            model.reaction_s,
+            model.min_lead_gap_s,
+            model.min_lag_gap_s,
+            self.scenes
+        )
+    }
+
+    /// The posterior mass of each cue.
+    pub fn cue_masses(&self) -> Vec<(&'static str, f64)> {
+        let weights = self.weights();
+        let total: f64 = weights.iter().sum();
+        let nt = self.grid.thresholds;
+        (self.grid.cues.iter())
+            .map(|(cue, first, thresholds)| {
+                let mass: f64 = (0..Grid::combinations())
+                    .flat_map(|c| {
+                        let start = c * nt + first;
+                        weights[start..start + thresholds.len()].iter()
+                    })
+                    .sum();
+                (cue.name(), if total > 0.0 { mass / total } else { 0.0 })
+            })
+            .collect()
+    }
+
+    /// The start predicted in a scene (`situations` at step `dt`, the ego's set
+    /// speed, the safety layer's verdict per step when it is on, a lane change
+    /// of `duration_s`): the start step with the largest posterior mass, the
+    /// earliest of equals.
+    pub fn predict(
+        &self,
+        situations: &[Situation],
+        dt: f64,
+        set_speed_mps: f64,
+        safe: Option<&[bool]>,
+        duration_s: f64,
+    ) -> Prediction {
+        if self.outside_model() {
+            return Prediction::OutsideModel;
+        }
+        let view = SceneView::new(situations, dt, set_speed_mps, safe, duration_s);
+        let starts = self.grid.starts(&view);
+        match starts[self.most_probable_index()] {
+            NEVER => Prediction::NoStart,
+            start => Prediction::Start(f64::from(start) * dt),
+        }
+    }
+
+    /// The posterior weights, scaled so that the largest is 1.
+    fn weights(&self) -> Vec<f64> {
+        let top = (self.log_posterior.iter().copied()).fold(f64::NEG_INFINITY, f64::max);
+        (self.log_posterior.iter())
+            .map(|&lp| {
+                if top.is_finite() {
+                    (lp - top).exp()
+                } else {
+                    0.0
+                }
+            })
+            .collect()
+    }
+}
+
+/// The log prior: each cue [`prior::cue_mass`], uniform over its thresholds;
+/// the reaction and the accepted gaps independent, each exponential on its grid
+/// with scale [`prior::DEMAND_SCALE_S`].
+fn prior(grid: &Grid) -> Vec<f64> {
+    let per_threshold: Vec<f64> = (grid.cues.iter())
+        .flat_map(|(cue, _, thresholds)| {
+            let log_mass = prior::cue_mass(*cue).ln() - (thresholds.len() as f64).ln();
+            std::iter::repeat_n(log_mass, thresholds.len())
+        })
+        .collect();
+    let demand = |values: &[f64]| -> Vec<f64> {
+        let log = |x: f64| -x / prior::DEMAND_SCALE_S;
+        let norm = values.iter().map(|&x| log(x).exp()).sum::<f64>().ln();
+        values.iter().map(|&x| log(x) - norm).collect()
+    };
+    let (reactions, leads, lags) = (
+        demand(&REACTIONS_S),
+        demand(&LEAD_GAPS_S),
+        demand(&LAG_GAPS_S),
+    );
+    let mut log_prior = Vec::with_capacity(grid.len());
+    for reaction in &reactions {
+        for lead in &leads {
+            for lag in &lags {
+                let combination = reaction + lead + lag;
+                log_prior.extend(per_threshold.iter().map(|t| t + combination));
+            }
+        }
+    }
+    log_prior
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A scene in which the headway falls from 2.2 s by 0.011 s per step behind
+    /// a slower leader, with the target lane's follower alongside until step 60.
+    fn approach() -> Vec<Situation> {
+        (0..300)
+            .map(|i| {
+                let headway = 2.2 - 0.011 * f64::from(i);
+                Situation {
+                    time_headway_s: headway,
+                    preceding_gap_m: headway * 20.0,
+                    preceding_speed: Some(18.0),
+                    target_lead_gap_m: Some(40.0 - 0.05 * f64::from(i)),
+                    target_lag_gap_m: Some(if i < 60 {
+                        -1.0
+                    } else {
+                        0.1 * f64::from(i - 60)
+                    }),
+                    ego_speed: 20.0,
+                    target_lead_speed: Some(18.0),
+                    target_lag_speed: Some(18.0),
+                }
+            })
+            .collect()
+    }
+
+    /// Scenes of the default config at seed 1, each prepared once.
+    fn scenes() -> &'static [crate::setup::Setup] {
+        static SETUPS: std::sync::OnceLock<Vec<crate::setup::Setup>> = std::sync::OnceLock::new();
+        SETUPS.get_or_init(|| {
+            let text = include_str!("../../../../configs/learn.toml");
+            let base = crate::config::LearnConfig::from_toml_str(text).unwrap();
+            [
+                ("collector-high", 40.0),
+                ("arterial-slow", 50.0),
+                ("collector-slow", 30.0),
+                ("arterial-high", 45.0),
+            ]
+            .into_iter()
+            .map(|(speed_case, headway_m)| {
+                let config = base.clone().with_cell(crate::config::CellChoice {
+                    speed_case: speed_case.into(),
+                    headway_m,
+                    seed: 1,
+                });
+                crate::scenario::prepare(&config).unwrap()
+            })
+            .collect()
+        })
+    }
+
+    /// The onset of a driver of `model` in `setup`, observed exactly; `None`
+    /// when it does not start there.
+    fn observed(model: &StartModel, setup: &crate::setup::Setup) -> Option<Onset> {
+        let (_, start) = model
+            .start_step(&setup.situations, setup.dt, setup.set_speed, |_| true)
+            .ok()?;
+        Some(Onset {
+            scenario: setup.label.clone(),
+            time_s: start as f64 * setup.dt,
+            time_headway_s: 1.0,
+            ttc_s: None,
+            gap_m: 1.0,
+            lead_time_gap_s: None,
+            lag_time_gap_s: None,
+            rejected_lead_time_gap_s: None,
+            time_headway_ceiling_s: None,
+            accepted_lead_time_gap_s: None,
+            follower_wait_time_headway_s: None,
+            observations: 1,
+            scene: Some(super::super::scene_steps(setup)),
+        })
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(24))]
+
+        /// A driver whose start model lies in the grid keeps the largest
+        /// likelihood after any sequence of its observations, and so a
+        /// posterior mass of at least its prior's share: the estimate never
+        /// rules the truth out, and never calls such a driver outside the model.
+        #[test]
+        fn a_driver_of_the_grid_is_never_ruled_out(
+            h in 0usize..400_000,
+            order in proptest::sample::subsequence(vec![0usize, 1, 2, 3], 1..=4),
+        ) {
+            let grid = Grid::new();
+            let h = h % grid.len();
+            let model = grid.model(h);
+            let onsets: Vec<Onset> = (order.iter())
+                .filter_map(|&i| observed(&model, &scenes()[i]))
+                .collect();
+            if let Some(estimate) = DriverEstimate::from_onsets(&onsets, 2.0) {
+                proptest::prop_assert!(!estimate.outside_model());
+                let log_likelihood = estimate.log_posterior[h] - prior(&grid)[h];
+                proptest::prop_assert!(
+                    log_likelihood.abs() < 1e-9,
+                    "{:?}: log likelihood {}", model, log_likelihood
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_driver_no_start_model_explains_is_outside_the_model() {
+        // A headway driver seen in two scenes is explained; the same driver
+        // said to have started at the first step of the second scene is not:
+        // no model starts there and at 1.2 s of headway in the first.
+        let setups = scenes();
+        let mut onsets: Vec<Onset> = (0..2)
+            .filter_map(|i| {
+                let model = StartModel {
+                    rule: palc_user::StartRule::TimeHeadway,
+                    time_headway_s: 1.2,
+                    reaction_s: 0.0,
+                    min_lead_gap_s: 0.0,
+                    min_lag_gap_s: 0.0,
+                };
+                observed(&model, &setups[i])
+            })
+            .collect();
+        assert_eq!(onsets.len(), 2);
+        let consistent = DriverEstimate::from_onsets(&onsets, 2.0).unwrap();
+        assert!(!consistent.outside_model());
+        onsets[1].time_s = 0.0;
+        let contradicted = DriverEstimate::from_onsets(&onsets, 2.0).unwrap();
+        assert!(contradicted.outside_model());
+        let (seen, dt, speed) = (&setups[2].situations, setups[2].dt, setups[2].set_speed);
+        assert_eq!(
+            contradicted.predict(seen, dt, speed, None, 2.0),
+            Prediction::OutsideModel
+        );
+    }
+
+    #[test]
+    fn the_fast_starts_are_the_start_models_own() {
+        let seen = approach();
+        let view = SceneView::new(&seen, 0.1, 25.0, None, 2.0);
+        let grid = Grid::new();
+        let starts = grid.starts(&view);
+        // Every 97th hypothesis, spread over every cue and combination.
+        for h in (0..grid.len()).step_by(97) {
+            let model = grid.model(h);
+            let reference = match model.start_step(&seen, 0.1, 25.0, |_| true) {
+                Ok((_, start)) => start as u32,
+                Err(_) => NEVER,
+            };
+            assert_eq!(starts[h], reference, "{model:?}");
+        }
+    }
+}
