@@ -118,7 +118,7 @@ impl Grid {
                     let out = &mut starts[c * self.thresholds..(c + 1) * self.thresholds];
                     for (start, &decided) in out.iter_mut().zip(&decision) {
                         if decided != NEVER {
-                            *start = next[(decided as usize + reaction).min(n)];
+                            *start = next[(decided as usize).saturating_add(reaction).min(n)];
                         }
                     }
                 }
