@@ -122,14 +122,6 @@ impl SceneSteps {
                 });
             }
         }
-        let (dt_low, dt_high) = crate::EXPERIENCE_DT_BOUNDS_S;
-        if !(dt_low..=dt_high).contains(&self.dt) {
-            return Err(AggregatorError::OutOfRange {
-                field: field("dt".to_owned()),
-                value: self.dt,
-                bound: format!("a step in [{dt_low}, {dt_high}] s"),
-            });
-        }
         for (i, step) in self.steps.iter().enumerate() {
             let pairs = [
                 ("preceding", step.preceding),

@@ -453,13 +453,6 @@ fn a_recorded_scene_round_trips_and_is_checked() {
     });
     experience.save(&path).unwrap();
     assert_eq!(Experience::load(&path).unwrap(), experience);
-    experience.onsets[0].scene.as_mut().unwrap().dt = 1e-300;
-    let message = experience.validate().unwrap_err().to_string();
-    assert!(
-        message.contains("onsets[0].scene.dt") && message.contains("0.001"),
-        "{message}"
-    );
-    experience.onsets[0].scene.as_mut().unwrap().dt = 0.1;
     experience.onsets[0].scene.as_mut().unwrap().steps[4].ego_speed = f64::NAN;
     let message = experience.validate().unwrap_err().to_string();
     assert!(
