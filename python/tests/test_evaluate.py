@@ -4,6 +4,8 @@ a bad config refused before anything is written."""
 
 from __future__ import annotations
 
+import os
+import signal
 import threading
 import time
 from pathlib import Path
@@ -88,6 +90,7 @@ def test_evaluate_writes_the_report_and_read_runs_reads_it(tmp_path: Path) -> No
     assert first["method"] == "palc" and first["style"] == "neutral"
     assert isinstance(first["takeovers"], int)
     assert calls[0] == (0, outcome["runs"]) and calls[-1] == (outcome["runs"], outcome["runs"])
+    assert outcome["idle_experiments"] == []
 
 
 def test_evaluate_in_a_thread_leaves_the_main_thread_responsive(tmp_path: Path) -> None:
@@ -128,3 +131,22 @@ def test_an_exception_in_the_progress_callback_is_raised(tmp_path: Path) -> None
 
     with pytest.raises(RuntimeError, match="the bar broke"):
         palc.evaluate(small_config(tmp_path), out=tmp_path / "out", jobs=1, progress=progress)
+    # The exception stopped the evaluation: nothing was written.
+    assert not (tmp_path / "out").exists()
+
+
+def test_ctrl_c_cancels_the_evaluation_and_writes_nothing(tmp_path: Path) -> None:
+    calls: list[tuple[int, int]] = []
+
+    def progress(done: int, total: int) -> None:
+        calls.append((done, total))
+        if done == 0:
+            # Ctrl-C before the first run; the sleep lets the waiting thread see it
+            # before any run starts.
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.5)
+
+    with pytest.raises(KeyboardInterrupt):
+        palc.evaluate(small_config(tmp_path), out=tmp_path / "out", jobs=1, progress=progress)
+    assert calls == [(0, calls[0][1])], "no run finished after Ctrl-C"
+    assert not (tmp_path / "out").exists()

@@ -740,3 +740,40 @@ fn too_many_traffic_rows_are_refused_before_the_output_is_touched() {
         "precious\n"
     );
 }
+
+/// An evaluation none of whose runs in an experiment could run (e.g.
+/// `timing.dts = [1e-300]`) exited 0, its failure a row in REPORT.md. The dense
+/// stress scene refuses every run on purpose and says so in `expected_refusals`.
+#[test]
+fn eval_exits_non_zero_naming_an_experiment_that_measured_nothing() {
+    let dir = scratch("eval-idle");
+    let base = workspace_file("configs/stress/dense.toml");
+    let text = read("configs/stress/dense-eval.toml").replace(
+        "base = \"dense.toml\"",
+        &format!("base = \"{}\"", base.display()),
+    );
+    assert!(text.contains("expected_refusals = ["));
+    std::fs::write(dir.join("eval.toml"), &text).unwrap();
+    let args = ["eval", "--quick", "--config", "eval.toml", "--out", "out"];
+    succeeds(&palc(&args, &dir));
+    // Without the declaration, the same refusals make every experiment idle.
+    let start = text.find("expected_refusals = [").unwrap();
+    let end = start + text[start..].find("\n]").unwrap() + 2;
+    let undeclared = format!("{}{}", &text[..start], &text[end..]);
+    std::fs::write(dir.join("eval.toml"), &undeclared).unwrap();
+    let output = palc(&args, &dir);
+    fails_with(
+        &output,
+        &[
+            "measured nothing",
+            "experiment `grid`: none of its 24 runs ran",
+            "most common reason: standard-",
+        ],
+    );
+    // The results are written all the same, the idle experiments named in the report.
+    let report = std::fs::read_to_string(dir.join("out/REPORT.md")).unwrap();
+    assert!(
+        report.contains("Experiments that measured nothing"),
+        "{report}"
+    );
+}

@@ -50,6 +50,12 @@ pub struct EvalConfig {
     /// reproduction is about 24 000): raise it for a larger study.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub max_runs: Option<usize>,
+    /// Refusal kinds (as in `refusals.csv`, e.g. `standard-gaps-unsafe`) that may
+    /// account for every run of an experiment, in a scene built to have no lane
+    /// change to learn (the dense stress scene); none by default. An experiment
+    /// none of whose runs ran for another reason is idle ([`crate::idle`]).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub expected_refusals: Vec<String>,
 }
 
 /// Closed-loop execution (`[closed_loop]`): every grid cell of these users run
@@ -358,6 +364,17 @@ impl EvalConfig {
                 0,
                 "at least 1 (leave it out for the default)",
             ));
+        }
+        for (i, kind) in self.expected_refusals.iter().enumerate() {
+            let well_formed = !kind.is_empty()
+                && (kind.bytes()).all(|b| b.is_ascii_lowercase() || b == b'-' || b == b'/');
+            if !well_formed {
+                return Err(EvalError::invalid(
+                    format!("expected_refusals[{i}]"),
+                    format_args!("{kind:?}"),
+                    "a refusal kind as in refusals.csv (lower-case words joined by `-`, `user/` before a user's)",
+                ));
+            }
         }
         self.grid.validate("grid")?;
         self.quick.grid.validate("quick.grid")?;

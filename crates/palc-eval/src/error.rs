@@ -41,6 +41,10 @@ pub enum EvalError {
         /// that a report would print twice).
         error: Box<toml::de::Error>,
     },
+    /// The evaluation was cancelled ([`crate::Progress::cancelled`]) before its
+    /// last run; nothing was written.
+    #[error("the evaluation was cancelled; no output was written")]
+    Cancelled,
     /// A config value is out of its bound.
     #[error("`{field}` is {value}, expected {bound}")]
     InvalidConfig {

@@ -42,6 +42,7 @@ pub mod families_report;
 #[cfg(feature = "plot")]
 pub mod figures;
 pub mod harness_runs;
+pub mod idle;
 pub mod manifest;
 pub mod plan;
 pub mod recorded_drivers;
@@ -61,6 +62,7 @@ use std::time::Instant;
 pub use config::{EvalConfig, Selection};
 pub use error::EvalError;
 pub use harness_runs::{ExampleTrace, HarnessRuns};
+pub use idle::IdleExperiment;
 pub use plan::{Experiment, RunPlan, RunSpec};
 pub use results::{Iteration, RunRow, Status};
 pub use runner::{NoProgress, Progress};
@@ -103,6 +105,10 @@ pub struct Outcome {
     pub runs: usize,
     /// Wall time of the runs (s).
     pub wall_s: f64,
+    /// The experiments none of whose runs ran ([`idle`]), with the most common
+    /// reason; the results are written all the same, and `palc eval` exits
+    /// non-zero when this is not empty.
+    pub idle: Vec<IdleExperiment>,
 }
 
 /// An evaluation config read and checked with its base learning config.
@@ -115,6 +121,7 @@ pub struct Evaluation {
     harness: HarnessRuns,
     quick: bool,
     max_runs: usize,
+    expected_refusals: Vec<String>,
 }
 
 /// Reads a config, at most `palc_aggregator::input::MAX_INPUT_BYTES`.
@@ -163,6 +170,7 @@ impl Evaluation {
             harness,
             quick,
             max_runs,
+            expected_refusals: config.expected_refusals,
         })
     }
 
@@ -238,6 +246,7 @@ pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcom
         .example(&example_spec)
         .map_err(|e| e.to_string());
 
+    let idle = idle::idle_experiments(&rows, &evaluation.expected_refusals);
     let selection = &evaluation.selection;
     let (git_commit, git_dirty) = manifest::git_state();
     let manifest = Manifest {
@@ -294,6 +303,7 @@ pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcom
         manifest: &manifest,
         ablation: (evaluation.harness.rungs(), &selection.ablation.users),
         recorded: evaluation.harness.recorded(),
+        idle: &idle,
     });
     write(&out.join("REPORT.md"), &report_text)?;
     // The example's files of an earlier run are not carried over when this one has
@@ -304,6 +314,7 @@ pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcom
         report,
         runs: rows.len(),
         wall_s,
+        idle,
     })
 }
 

@@ -33,6 +33,8 @@ pub struct ReportInput<'a> {
     pub ablation: (&'a [crate::ablation::Rung], &'a [String]),
     /// The recorded user kinds' drivers.
     pub recorded: &'a [crate::recorded_drivers::RecordedDrivers],
+    /// The experiments none of whose runs ran.
+    pub idle: &'a [crate::IdleExperiment],
 }
 
 /// Writes REPORT.md's text.
@@ -75,7 +77,7 @@ pub fn render(input: &ReportInput) -> String {
     claims_section(&mut out);
     crate::safety_report::section(&mut out, input.rows, input.methods);
     crate::closed_loop_report::section(&mut out, input.rows, input.methods, input.users);
-    refusals(&mut out, input.rows);
+    refusals(&mut out, input.rows, input.idle);
     learning_failures(&mut out, input);
     crate::timing_report::section(&mut out, input.rows, input.methods);
     example_section(&mut out, input);
@@ -370,7 +372,7 @@ fn sensitivity_table(
 /// `refusals.csv`), then the runs that stopped on an error, counted by the
 /// error's kind (its first clause, e.g. `problem is infeasible`; every one is in
 /// `runs.csv` with its message).
-fn refusals(out: &mut String, rows: &[RunRow]) {
+fn refusals(out: &mut String, rows: &[RunRow], idle: &[crate::IdleExperiment]) {
     let refused: Vec<Counted> = (rows.iter())
         .filter_map(|row| match &row.status {
             Status::Refused { reason, .. } => Some(Counted {
@@ -401,6 +403,17 @@ fn refusals(out: &mut String, rows: &[RunRow]) {
         rows.len(),
         failed.len()
     );
+    if !idle.is_empty() {
+        let _ = writeln!(
+            out,
+            "**Experiments that measured nothing** (`palc eval` exits non-zero; a scene built to \
+             refuse lists its refusal kinds in the config's `expected_refusals`):\n"
+        );
+        for experiment in idle {
+            let _ = writeln!(out, "- {experiment}");
+        }
+        let _ = writeln!(out);
+    }
     kind_table(out, "kind", &refused);
     if !failed.is_empty() {
         let _ = writeln!(
@@ -658,6 +671,7 @@ mod tests {
             manifest: &manifest,
             ablation: (&[], &[]),
             recorded: &[],
+            idle: &[],
         });
         assert!(
             report

@@ -39,6 +39,12 @@ pub trait Progress: Sync {
     fn finished(&self, _row: &RunRow) {}
     /// Called once after the last run.
     fn done(&self) {}
+    /// Whether the evaluation is to stop: asked before each run; once it answers
+    /// yes, the runs not started are skipped and [`execute`] returns
+    /// [`EvalError::Cancelled`] (no output is written). Never, by default.
+    fn cancelled(&self) -> bool {
+        false
+    }
 }
 
 /// A [`Progress`] that shows nothing.
@@ -89,6 +95,9 @@ pub fn execute<E: Executor>(
                 .first
                 .par_iter()
                 .map(|spec| {
+                    if progress.cancelled() {
+                        return (skipped(spec, executor.cap()), None);
+                    }
                     let (row, experience) = executor.run(spec, None);
                     progress.finished(&row);
                     let keep = sources.contains(&spec.id);
@@ -120,7 +129,7 @@ pub fn execute<E: Executor>(
             .filter(|s| transfer[s.id - offset].is_none())
             .filter(|s| s.experience_from.is_none_or(|id| ended(id, &transfer)))
             .collect();
-        if wave.is_empty() {
+        if wave.is_empty() || progress.cancelled() {
             break;
         }
         let done: Vec<(RunRow, Option<E::Experience>)> = pool.install(|| {
@@ -163,10 +172,21 @@ pub fn execute<E: Executor>(
             transfer[index] = Some(row);
         }
     }
+    if progress.cancelled() {
+        return Err(EvalError::Cancelled);
+    }
     rows.extend(transfer.into_iter().flatten());
     progress.done();
     debug_assert!(rows.iter().enumerate().all(|(i, row)| row.spec.id == i));
     Ok(rows)
+}
+
+/// The row of a run skipped because the evaluation was cancelled; never written.
+fn skipped(spec: &RunSpec, cap: usize) -> RunRow {
+    let status = Status::Failed {
+        error: "cancelled".to_owned(),
+    };
+    RunRow::without_result(spec.clone(), status, cap, 0.0)
 }
 
 impl RunSpec {
@@ -280,6 +300,40 @@ pub(crate) mod tests {
     pub(crate) fn synthetic_rows() -> Vec<RunRow> {
         let plan = plan::expand(&plan::tests::selection(), &plan::tests::testbed()).unwrap();
         execute(&plan, &Synthetic, 2, &NoProgress).unwrap()
+    }
+
+    /// Cancels once `after` runs have finished, counting the runs finished.
+    struct CancelAfter {
+        after: usize,
+        finished: std::sync::atomic::AtomicUsize,
+    }
+
+    impl Progress for CancelAfter {
+        fn finished(&self, _row: &RunRow) {
+            self.finished
+                .fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        }
+        fn cancelled(&self) -> bool {
+            self.finished.load(std::sync::atomic::Ordering::SeqCst) >= self.after
+        }
+    }
+
+    #[test]
+    fn a_cancelled_evaluation_stops_starting_runs_and_returns_cancelled() {
+        let plan = plan::expand(&plan::tests::selection(), &plan::tests::testbed()).unwrap();
+        assert!(
+            plan.len() > 10,
+            "the test needs more runs than it lets finish"
+        );
+        let progress = CancelAfter {
+            after: 3,
+            finished: Default::default(),
+        };
+        let result = execute(&plan, &Synthetic, 1, &progress);
+        assert!(matches!(result, Err(EvalError::Cancelled)), "{result:?}");
+        // On one thread, the run that made the count reach 3 is the last one started.
+        let finished = progress.finished.load(std::sync::atomic::Ordering::SeqCst);
+        assert_eq!(finished, 3);
     }
 
     #[test]

@@ -75,6 +75,27 @@ pub enum HarnessError {
         /// that a report would print twice).
         error: Box<toml::de::Error>,
     },
+    /// The experience a run starts from plans its first lane change off the road:
+    /// weights that pass the planner's convexity check can still pull the ego
+    /// sideways without bound (a large negative weight on `l`), so the first plan
+    /// from a given experience is checked against the road's edges.
+    #[error(
+        "scenario {scenario}: the experience's weights plan the first lane change off the road \
+         (l = {l:?} m at step {step}, the road spans [{right_edge:?}, {left_edge:?}] m); \
+         the experience is refused"
+    )]
+    ExperienceOffRoad {
+        /// The scenario's label.
+        scenario: String,
+        /// The first step of the plan off the road.
+        step: usize,
+        /// The lateral position planned there (m).
+        l: f64,
+        /// The road's right edge (m).
+        right_edge: f64,
+        /// The road's left edge (m).
+        left_edge: f64,
+    },
     /// An error of the traffic simulation.
     #[error(transparent)]
     Traffic(#[from] palc_traffic::SceneError),

@@ -5,12 +5,19 @@
 //! The outputs are written as by the command line: into a staging directory that
 //! replaces `out` only when every file is written, so a failure leaves the previous
 //! results. Progress is reported from the evaluation's worker threads, each call
-//! with the GIL held; an exception in the callback is raised when the evaluation
-//! ends, and the callback is not called again.
+//! with the GIL held; an exception in the callback stops the evaluation (no run is
+//! started after it, nothing is written) and is raised, and the callback is not
+//! called again.
+//!
+//! The runs go on in a thread of their own while the calling thread waits with the
+//! GIL released and looks for signals every [`SIGNAL_POLL`]: Ctrl-C (or any signal
+//! whose handler raises) cancels the evaluation in the same way and its exception
+//! (`KeyboardInterrupt`) is raised once the runs in progress have ended.
 
 use std::path::PathBuf;
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::time::Duration;
 
 use palc_eval::{EvalError, EvalOptions, Progress, RunRow};
 use pyo3::prelude::*;
@@ -25,7 +32,13 @@ struct PythonProgress {
     total: AtomicUsize,
     done: AtomicUsize,
     raised: Mutex<Option<PyErr>>,
+    /// Set when a signal handler raised: the evaluation is to stop.
+    interrupted: AtomicBool,
 }
+
+/// How often the waiting thread looks for signals: short enough that Ctrl-C feels
+/// immediate, long enough to cost nothing next to a run (milliseconds each).
+const SIGNAL_POLL: Duration = Duration::from_millis(50);
 
 impl PythonProgress {
     /// Calls the target with the GIL held, unless it raised before.
@@ -66,6 +79,11 @@ impl Progress for PythonProgress {
             }
             Ok(())
         });
+    }
+
+    fn cancelled(&self) -> bool {
+        self.interrupted.load(Ordering::Relaxed)
+            || self.raised.lock().map_or(true, |raised| raised.is_some())
     }
 
     fn finished(&self, _row: &RunRow) {
@@ -114,7 +132,11 @@ fn classify(error: &EvalError) -> Raise {
 /// ``None``); the results do not depend on it. ``progress`` is a callable
 /// ``progress(done, total)`` or a tqdm bar. The GIL is released while the runs go on.
 ///
-/// Returns a dict with ``report`` (the path of ``REPORT.md``), ``runs`` and ``wall_s``.
+/// Returns a dict with ``report`` (the path of ``REPORT.md``), ``runs``, ``wall_s`` and
+/// ``idle_experiments`` (one message per experiment none of whose runs ran; ``palc
+/// eval`` exits non-zero for them). Ctrl-C stops the evaluation: no run starts after
+/// it, nothing is written, and ``KeyboardInterrupt`` is raised when the runs in
+/// progress end.
 #[pyfunction]
 #[pyo3(signature = (config = PathBuf::from("configs/reproduce.toml"), *, out = PathBuf::from("target/reproduce-paper"), quick = false, jobs = None, progress = None))]
 pub fn evaluate<'py>(
@@ -148,8 +170,12 @@ pub fn evaluate<'py>(
             total: AtomicUsize::new(0),
             done: AtomicUsize::new(0),
             raised: Mutex::new(None),
+            interrupted: AtomicBool::new(false),
         };
-        let outcome = py.detach(|| palc_eval::evaluate(&options, &shown));
+        let (outcome, signal) = run_watching_signals(py, &options, &shown);
+        if let Some(error) = signal {
+            return Err(error);
+        }
         if let Some(error) = shown.raised.lock().ok().and_then(|mut r| r.take()) {
             return Err(error);
         }
@@ -158,6 +184,35 @@ pub fn evaluate<'py>(
         dict.set_item("report", outcome.report)?;
         dict.set_item("runs", outcome.runs)?;
         dict.set_item("wall_s", outcome.wall_s)?;
+        let idle: Vec<String> = outcome.idle.iter().map(|e| e.to_string()).collect();
+        dict.set_item("idle_experiments", idle)?;
         Ok(dict)
+    })
+}
+
+/// Runs the evaluation in a scoped thread; this thread waits with the GIL released
+/// and, every [`SIGNAL_POLL`], runs Python's signal handlers. The first exception
+/// a handler raises cancels the evaluation and is returned beside its result.
+fn run_watching_signals(
+    py: Python<'_>,
+    options: &EvalOptions,
+    shown: &PythonProgress,
+) -> (Result<palc_eval::Outcome, EvalError>, Option<PyErr>) {
+    std::thread::scope(|scope| {
+        let runs = scope.spawn(|| palc_eval::evaluate(options, shown));
+        let mut signal = None;
+        while !runs.is_finished() {
+            py.detach(|| std::thread::sleep(SIGNAL_POLL));
+            if signal.is_none() {
+                if let Err(error) = py.check_signals() {
+                    shown.interrupted.store(true, Ordering::Relaxed);
+                    signal = Some(error);
+                }
+            }
+        }
+        match runs.join() {
+            Ok(outcome) => (outcome, signal),
+            Err(panic) => std::panic::resume_unwind(panic),
+        }
     })
 }

@@ -114,5 +114,18 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
         outcome.wall_s,
         outcome.report.display()
     );
+    if !outcome.idle.is_empty() {
+        let experiments: Vec<String> = outcome.idle.iter().map(|e| e.to_string()).collect();
+        anyhow::bail!(
+            "the results are written, but {} measured nothing:\n  {}\n(a scene built to refuse \
+             lists its refusal kinds in the config's `expected_refusals`)",
+            if experiments.len() == 1 {
+                "one experiment"
+            } else {
+                "some experiments"
+            },
+            experiments.join("\n  ")
+        );
+    }
     Ok(())
 }

@@ -150,6 +150,7 @@ impl LearningLoop {
             options,
         };
         let personalization = personalization::for_options(&policy.options);
+        let given_experience = experience.is_some();
         // The standard ALC's weights at this scenario's horizon: a fresh
         // experience's, and the safety layer's fallback.
         let standard_lane_change = setup.standard_lane_change(&config.planning.standard_alc);
@@ -207,6 +208,9 @@ impl LearningLoop {
         )?;
         let started = Instant::now();
         let next_plan = planner.plan(&first_problem)?;
+        if given_experience {
+            check_on_road(&setup, &label, &next_plan)?;
+        }
         let pending_times = Timings {
             plan_s: started.elapsed().as_secs_f64(),
             ..Timings::default()
@@ -566,4 +570,24 @@ pub fn run(
     observer: &mut dyn Observer,
 ) -> Result<RunResult, HarnessError> {
     LearningLoop::new(config, experience)?.run(observer)
+}
+
+/// The plan's centre line stays between the road's edges (within 1 µm), else
+/// [`HarnessError::ExperienceOffRoad`] at its first step past them.
+fn check_on_road(setup: &Setup, label: &str, plan: &Plan) -> Result<(), HarnessError> {
+    const EDGE_TOLERANCE_M: f64 = 1e-6;
+    let road = setup.scene.road();
+    let (right_edge, left_edge) = (road.right_edge(), road.left_edge());
+    let inside =
+        |l: f64| (right_edge - EDGE_TOLERANCE_M..=left_edge + EDGE_TOLERANCE_M).contains(&l);
+    match plan.states.iter().position(|x| !inside(x.l)) {
+        None => Ok(()),
+        Some(step) => Err(HarnessError::ExperienceOffRoad {
+            scenario: label.to_owned(),
+            step,
+            l: plan.states[step].l,
+            right_edge,
+            left_edge,
+        }),
+    }
 }
