@@ -289,8 +289,12 @@ impl Experience {
         Self::from_json(&bytes, path)
     }
 
-    /// Parses the bytes of an experience file; `path` only names it in errors.
-    fn from_json(bytes: &[u8], path: &Path) -> Result<Self, AggregatorError> {
+    /// Parses and checks the bytes of an experience file as [`Experience::load`]
+    /// does; `path` only names it in errors.
+    ///
+    /// # Errors
+    /// As [`Experience::load`], without its I/O errors.
+    pub fn from_json(bytes: &[u8], path: &Path) -> Result<Self, AggregatorError> {
         // A UTF-8 byte-order mark (some editors write one) is not part of the JSON.
         let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
         let corrupt = |reason: String| AggregatorError::Corrupt {

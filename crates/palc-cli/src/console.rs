@@ -98,7 +98,8 @@ pub fn report(error: &anyhow::Error) {
 /// `error` for the user: its message, then each cause the message above it
 /// does not already quote (the library errors name their cause in their own
 /// message, so a plain chain said the operating system's error twice), then
-/// the backtrace when one was captured (`RUST_BACKTRACE=1`).
+/// the backtrace when one was captured (`RUST_BACKTRACE=1`). Numbers a parser
+/// wrote out in full are shortened ([`shortest_numbers`]).
 fn rendered(error: &anyhow::Error) -> String {
     let mut text = format!("Error: {error}");
     let mut above = error.to_string();
@@ -109,6 +110,7 @@ fn rendered(error: &anyhow::Error) -> String {
         }
         above = message;
     }
+    let mut text = shortest_numbers(&text);
     let backtrace = error.backtrace();
     if backtrace.status() == std::backtrace::BacktraceStatus::Captured {
         text.push_str(&format!("\n\nStack backtrace:\n{backtrace}"));
@@ -116,9 +118,60 @@ fn rendered(error: &anyhow::Error) -> String {
     text
 }
 
+/// Longest number written out as it is: more digits than any `f64` needs
+/// (17 significant, a sign, a point and a few zeros).
+const LONGEST_PLAIN_NUMBER: usize = 24;
+
+/// `text` with every decimal number longer than [`LONGEST_PLAIN_NUMBER`]
+/// characters written in its shortest round-trip form (`1e300` for the 301
+/// digits a parser's message may print for it).
+fn shortest_numbers(text: &str) -> String {
+    let bytes = text.as_bytes();
+    let mut out = String::with_capacity(text.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        let starts_number = bytes[i].is_ascii_digit()
+            || (bytes[i] == b'-' && bytes.get(i + 1).is_some_and(u8::is_ascii_digit));
+        let after_word = i > 0 && (bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'_');
+        if starts_number && !after_word {
+            let mut end = i + 1;
+            while end < bytes.len() && (bytes[end].is_ascii_digit() || bytes[end] == b'.') {
+                end += 1;
+            }
+            let token = &text[i..end];
+            match token.parse::<f64>() {
+                Ok(value) if token.len() > LONGEST_PLAIN_NUMBER => {
+                    out.push_str(&format!("{value:?}"))
+                }
+                _ => out.push_str(token),
+            }
+            i = end;
+        } else {
+            let next = text[i..].chars().next().map_or(1, char::len_utf8);
+            out.push_str(&text[i..i + next]);
+            i += next;
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn numbers_a_parser_writes_out_in_full_are_shortened() {
+        let huge = format!("{}", 1e300);
+        let tiny = format!("{}", -1e-300);
+        let text = format!(
+            "floating point `{huge}`, expected u64; speed {tiny} m/s; seed 18446744073709551615, v2 3.5"
+        );
+        assert_eq!(
+            shortest_numbers(&text),
+            "floating point `1e300`, expected u64; speed -1e-300 m/s; seed 18446744073709551615, v2 3.5"
+        );
+        assert_eq!(shortest_numbers("naïve 0.1 — x"), "naïve 0.1 — x");
+    }
 
     #[test]
     fn a_cause_the_message_already_quotes_is_not_repeated() {

@@ -2,7 +2,10 @@
 //! random truncations and random field mutations of the shipped examples in
 //! `configs/` (the learn, test-bed, platoon and evaluation configs, the plan problem,
 //! the zone config, the zone model that `palc zone fit` writes for the zone example,
-//! and the samples and points CSVs). Each parser must return a typed error or a
+//! the samples and points CSVs, the user file `configs/examples/user.toml`) and of
+//! the experience file that `palc learn --save-experience` writes for the default
+//! config (weights, zone, onsets with their scenes, anchor and demonstration). An
+//! accepted experience is also planned from, as `palc learn --experience` does. Each parser must return a typed error or a
 //! value that is valid and carries no NaN; none may panic. A zone model or points
 //! file that parses is also classified: every posterior must be a probability.
 //!
@@ -16,6 +19,7 @@
 //! model 3.4 s, zone samples CSV 17.9 s, zone points CSV 8.2 s. Most mutated inputs
 //! are refused by the parser or the validation, so these times are mostly parsing.
 
+use palc_aggregator::Experience;
 use palc_eval::EvalConfig;
 use palc_harness::LearnConfig;
 use palc_planner::Planner;
@@ -40,6 +44,20 @@ const PLAN: &str = include_str!("../../../configs/examples/plan-problem.json");
 const SAMPLES: &str = include_str!("../../../configs/examples/zone-samples.csv");
 const ZONE: &str = include_str!("../../../configs/examples/zone.toml");
 const POINTS: &str = include_str!("../../../configs/examples/zone-points.csv");
+const USER: &str = include_str!("../../../configs/examples/user.toml");
+
+/// The experience `palc learn --save-experience` writes for the default config,
+/// as its JSON text: the example of the experience format.
+static EXPERIENCE: LazyLock<&'static str> = LazyLock::new(|| {
+    let config = LearnConfig::from_toml_str(LEARN).unwrap();
+    let result = palc_harness::run(&config, None, &mut palc_harness::NoObserver).unwrap();
+    let path =
+        std::env::temp_dir().join(format!("palc-fuzz-experience-{}.json", std::process::id()));
+    result.experience.save(&path).unwrap();
+    let text = std::fs::read_to_string(&path).unwrap();
+    let _ = std::fs::remove_file(&path);
+    Box::leak(text.into_boxed_str())
+});
 
 /// The model that `palc zone fit` writes for the shipped zone example (config and
 /// samples), as pretty JSON: the example of the zone-model format.
@@ -304,6 +322,35 @@ proptest! {
     }
 
     #[test]
+    fn fuzz_experience(text in mutated(*EXPERIENCE)) {
+        // As `palc learn --experience`: parsed and checked, then planned from.
+        static CONFIG: LazyLock<LearnConfig> =
+            LazyLock::new(|| LearnConfig::from_toml_str(LEARN).unwrap());
+        let path = std::path::Path::new("experience.json");
+        if let Ok(experience) = Experience::from_json(text.as_bytes(), path) {
+            no_nan(&experience)?;
+            if let Ok(run) = palc_harness::LearningLoop::new(&CONFIG, Some(&experience)) {
+                no_nan(&run.next_plan().states)?;
+            }
+        }
+    }
+
+    #[test]
+    fn fuzz_user_file(text in mutated(USER)) {
+        // As `palc learn --user`: parsed and checked, then asked for its lane change.
+        static CONFIG: LazyLock<LearnConfig> =
+            LazyLock::new(|| LearnConfig::from_toml_str(LEARN).unwrap());
+        let threshold = CONFIG.planning.takeover_threshold_m;
+        if let Ok(user) = palc_harness::UserConfig::from_toml_str(&text, threshold) {
+            no_nan(&user)?;
+            let config = CONFIG.clone().with_user(user);
+            if let Ok(run) = palc_harness::LearningLoop::new(&config, None) {
+                no_nan(&run.next_plan().states)?;
+            }
+        }
+    }
+
+    #[test]
     fn fuzz_zone_points(text in mutated(POINTS)) {
         static FITTED: LazyLock<ZoneModel> =
             LazyLock::new(|| ZoneModel::fit(example_zone_config(), &example_samples()).unwrap());
@@ -323,6 +370,11 @@ fn the_shipped_examples_parse() {
         Scene::from_config(&config, 0).unwrap();
     }
     EvalConfig::from_toml_str(REPRODUCE).unwrap();
+    palc_harness::UserConfig::from_toml_str(USER, 0.3).unwrap();
+    let experience =
+        Experience::from_json(EXPERIENCE.as_bytes(), std::path::Path::new("e.json")).unwrap();
+    assert!(experience.metadata.lessons > 0, "{:?}", experience.metadata);
+    assert!(!experience.onsets.is_empty() && experience.demonstration.is_some());
     let input: PlanInput = crate::parse::json(PLAN.as_bytes()).unwrap();
     Planner::new(input.config)
         .unwrap()

@@ -22,7 +22,7 @@ pub enum Refusal {
     #[error("the scene has no ego vehicle")]
     NoEgo,
     /// The ego does not move at the start.
-    #[error("the ego speed is {speed_mps} m/s, expected > 0")]
+    #[error("the ego speed is {speed_mps:?} m/s, expected > 0")]
     EgoNotMoving {
         /// The ego's speed (m/s).
         speed_mps: f64,
@@ -32,8 +32,8 @@ pub enum Refusal {
     NoPreceding,
     /// The time headway never falls to the planning trigger.
     #[error(
-        "the time headway never falls to the trigger {trigger_time_headway_s} s within \
-         {max_approach_s} s"
+        "the time headway never falls to the trigger {trigger_time_headway_s:?} s within \
+         {max_approach_s:?} s"
     )]
     NeverTriggers {
         /// The trigger's time headway (s).
@@ -51,14 +51,14 @@ pub enum Refusal {
         speed_mps: f64,
     },
     /// The standard ALC's start rule is never met.
-    #[error("the standard ALC never starts within the {window_s} s search window")]
+    #[error("the standard ALC never starts within the {window_s:?} s search window")]
     StandardNeverStarts {
         /// The search window (s).
         window_s: f64,
     },
     /// One of the paper's styles never starts, so the standard ALC cannot wait for it.
     #[error(
-        "a user ({time_headway_s} s headway) never starts within the {window_s} s search window"
+        "a user ({time_headway_s:?} s headway) never starts within the {window_s:?} s search window"
     )]
     StyleNeverStarts {
         /// The style's time headway (s).
@@ -69,8 +69,8 @@ pub enum Refusal {
     /// Under the safety layer, the target lane's gaps never stay at the safe
     /// distance over the standard ALC's lane change.
     #[error(
-        "no safe lane change for the standard ALC's {duration_s} s lane change within the \
-         {window_s} s search window: the target-lane gaps stay below the safe distance"
+        "no safe lane change for the standard ALC's {duration_s:?} s lane change within the \
+         {window_s:?} s search window: the target-lane gaps stay below the safe distance"
     )]
     StandardGapsUnsafe {
         /// The standard ALC's lane-change duration (s).
@@ -80,8 +80,8 @@ pub enum Refusal {
     },
     /// The ego has reached the preceding vehicle when the standard ALC would start.
     #[error(
-        "no safe lane change for the standard ALC's {duration_s} s lane change within the \
-         {window_s} s search window: the ego has reached the preceding vehicle (time headway \
+        "no safe lane change for the standard ALC's {duration_s:?} s lane change within the \
+         {window_s:?} s search window: the ego has reached the preceding vehicle (time headway \
          {time_headway_s:.2} s) when the standard ALC would start, {delay_steps} steps after \
          the latest user"
     )]
@@ -137,8 +137,8 @@ pub enum Refusal {
     },
     /// The paper's premise: the standard ALC's lane change is no slower than a style's.
     #[error(
-        "the standard ALC's lane change ({standard_duration_s} s) is not slower than the {style} \
-         user's ({user_duration_s} s)"
+        "the standard ALC's lane change ({standard_duration_s:?} s) is not slower than the {style} \
+         user's ({user_duration_s:?} s)"
     )]
     StandardNotSlower {
         /// The standard ALC's duration (s).
@@ -157,7 +157,7 @@ pub enum Refusal {
         refusal: UserRefusal,
     },
     /// The user would take over its own lane change.
-    #[error("user `{user}` would take over its own lane change at step {step} ({cause:?})")]
+    #[error("user `{user}` would take over its own lane change at step {step}: {cause}")]
     OwnLaneChangeTakenOver {
         /// The user's name.
         user: String,

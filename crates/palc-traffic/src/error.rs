@@ -68,7 +68,7 @@ pub enum ConfigError {
     /// The ego is not faster than the background traffic, so it is not impeded and the
     /// scenario is no discretionary lane change (paper, Section III.A).
     #[error(
-        "speed case `{case}`: ego speed {ego_mph} mph must be above the others' speed {others_mph} mph"
+        "speed case `{case}`: ego speed {ego_mph:?} mph must be above the others' speed {others_mph:?} mph"
     )]
     NotImpeded {
         /// Name of the speed case.

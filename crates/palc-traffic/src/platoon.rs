@@ -37,7 +37,7 @@ pub(crate) fn build(config: &ScenarioConfig) -> Result<Scene, ConfigError> {
         platoon.leader_start_s_m,
         0.0,
         road.length,
-        &format!("in [0, road.length_m = {}] m", road.length),
+        &format!("in [0, road.length_m = {:?}] m", road.length),
     )?;
     let v_init = mph_to_mps(speed_mph(
         "platoon.initial_speed_mph",

@@ -227,7 +227,7 @@ pub(crate) fn build(config: &ScenarioConfig, cell: &TestbedCell) -> Result<Scene
         testbed.ego_start_s_m,
         0.0,
         road.length,
-        &format!("in [0, road.length_m = {}] m", road.length),
+        &format!("in [0, road.length_m = {:?}] m", road.length),
     )?;
     let time_headway = positive(
         "testbed.initial_time_headway_s",

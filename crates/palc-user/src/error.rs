@@ -126,7 +126,7 @@ pub enum UserRefusal {
     /// The profile's lateral acceleration or jerk is beyond the bounds.
     #[error(
         "its {profile} profile over {duration_s:.2} s is not smooth enough: lateral acceleration \
-         {acceleration_mps2:.1} m/s² (at most {max_acceleration_mps2}), jerk {jerk_mps3:.0} m/s³ \
+         {acceleration_mps2:.1} m/s² (at most {max_acceleration_mps2:?}), jerk {jerk_mps3:.0} m/s³ \
          (at most {max_jerk_mps3})"
     )]
     NotSmooth {

@@ -111,6 +111,31 @@ pub enum TakeoverCause {
     },
 }
 
+impl std::fmt::Display for TakeoverCause {
+    /// In words, e.g. `the target lane's follower at a 0.58 s time gap`.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match *self {
+            TakeoverCause::Deviation => write!(f, "the plan strayed past its deviation bound"),
+            TakeoverCause::PerceivedSafety {
+                lead,
+                time_gap_s,
+                ttc_s,
+            } => {
+                let who = if lead { "leader" } else { "follower" };
+                write!(f, "the target lane's {who} came too near")?;
+                if let Some(gap) = time_gap_s {
+                    write!(f, ": a {gap:.2} s time gap")?;
+                }
+                if let Some(ttc) = ttc_s {
+                    let sep = if time_gap_s.is_some() { "," } else { ":" };
+                    write!(f, "{sep} {ttc:.2} s to collision")?;
+                }
+                Ok(())
+            }
+        }
+    }
+}
+
 /// When a user takes over a plan.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct TakeoverRule {
