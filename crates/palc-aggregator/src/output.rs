@@ -65,6 +65,64 @@ pub fn write_with(
     })
 }
 
+/// Checks, before any work, that [`write`] could write `path`: it is not a
+/// directory, its directory exists, and a file can be created there (a temporary
+/// one, removed at once). A command calls it for each output it was given, so that
+/// a bad `--out` is refused in a second rather than after a run of minutes.
+///
+/// # Errors
+/// [`OutputError`] naming `path` and what is wrong.
+pub fn check_writable(path: &Path) -> Result<(), OutputError> {
+    check_inner(path).map_err(|error| OutputError {
+        path: path.to_owned(),
+        error,
+    })
+}
+
+fn check_inner(path: &Path) -> io::Result<()> {
+    let target = resolve_symlinks(path)?;
+    match fs::metadata(&target) {
+        Ok(metadata) if metadata.is_dir() => {
+            return Err(io::Error::new(
+                io::ErrorKind::IsADirectory,
+                "the path is a directory, not a file",
+            ));
+        }
+        // A device or a pipe is written in place.
+        Ok(metadata) if !metadata.is_file() => return Ok(()),
+        Ok(_) => {}
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {}
+        Err(e) => return Err(e),
+    }
+    if target.file_name().is_none() {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "the path names no file",
+        ));
+    }
+    let directory = parent_directory(&target);
+    match fs::metadata(&directory) {
+        Ok(metadata) if metadata.is_dir() => {}
+        Ok(_) => {
+            return Err(io::Error::new(
+                io::ErrorKind::NotADirectory,
+                format!("{} is not a directory", directory.display()),
+            ));
+        }
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+            return Err(io::Error::new(
+                io::ErrorKind::NotFound,
+                format!("the directory {} does not exist", directory.display()),
+            ));
+        }
+        Err(e) => return Err(e),
+    }
+    tempfile::Builder::new()
+        .prefix(".palc-check-")
+        .tempfile_in(&directory)
+        .map(drop)
+}
+
 fn write_inner(path: &Path, fill: impl FnOnce(&mut dyn Write) -> io::Result<()>) -> io::Result<()> {
     let target = resolve_symlinks(path)?;
     let existing = match fs::metadata(&target) {

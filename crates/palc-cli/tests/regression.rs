@@ -777,3 +777,48 @@ fn eval_exits_non_zero_naming_an_experiment_that_measured_nothing() {
         "{report}"
     );
 }
+
+/// An output that cannot be written was found only after the work: `palc learn
+/// --save-experience` into a missing directory ran the whole run first.
+#[test]
+fn outputs_that_cannot_be_written_are_refused_before_the_work() {
+    let dir = scratch("outputs-before-work");
+    let config = workspace_file("configs/learn.toml");
+    let config = config.to_str().unwrap();
+    for args in [
+        vec![
+            "learn",
+            "--config",
+            config,
+            "--save-experience",
+            "missing/e.json",
+        ],
+        vec!["learn", "--config", config, "--record", "."],
+        vec![
+            "user",
+            "expect",
+            "--config",
+            config,
+            "--out",
+            "missing/expected.csv",
+        ],
+    ] {
+        let output = palc(&args, &dir);
+        let missing = if args.contains(&".") {
+            "is a directory"
+        } else {
+            "missing"
+        };
+        fails_with(&output, &[missing]);
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert!(
+            !stdout.contains("takeover") && !stdout.contains("written"),
+            "the work ran first: {stdout}"
+        );
+    }
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        0,
+        "a file was left"
+    );
+}

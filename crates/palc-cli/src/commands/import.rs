@@ -48,6 +48,7 @@ pub fn run(args: ImportArgs) -> anyhow::Result<()> {
 }
 
 fn commonroad(args: CommonroadArgs) -> anyhow::Result<()> {
+    output::check_writable(&args.out)?;
     let mut file = RecordedLaneChanges::new();
     for path in &args.scenarios {
         let scenario = import::import_file(path)?;

@@ -163,6 +163,9 @@ impl Observer for Printer {
 
 /// Runs `palc learn`.
 pub fn run_learn(args: LearnArgs) -> anyhow::Result<()> {
+    for path in [&args.save_experience, &args.record].into_iter().flatten() {
+        output::check_writable(path)?;
+    }
     let config = load_config(&args.scenario)?;
     let experience = match &args.experience {
         Some(path) => Some(

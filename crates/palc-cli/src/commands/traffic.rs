@@ -72,6 +72,7 @@ pub fn run(args: TrafficArgs) -> anyhow::Result<()> {
 }
 
 fn simulate(args: &SimulateArgs) -> anyhow::Result<()> {
+    output::check_writable(&args.out)?;
     let text = palc_aggregator::input::read_to_string(&args.config)?;
     let config = ScenarioConfig::from_toml_str(&text)
         .with_context(|| format!("in {}", args.config.display()))?;

@@ -42,6 +42,7 @@ pub fn run(args: UserArgs) -> anyhow::Result<()> {
 }
 
 fn expect(args: ExpectArgs) -> anyhow::Result<()> {
+    output::check_writable(&args.out)?;
     let config = load_config(&args.scenario)?;
     let (setup, expectation) = palc_harness::advanced::expectation(&config)?;
     let lane_change = &expectation.lane_change;

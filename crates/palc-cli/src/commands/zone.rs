@@ -90,6 +90,7 @@ pub fn run(args: ZoneArgs) -> anyhow::Result<()> {
 }
 
 fn fit(args: &FitArgs) -> anyhow::Result<()> {
+    output::check_writable(&args.out)?;
     let mut config = match &args.config {
         Some(path) => {
             let text = input::read_to_string(path)?;
@@ -133,6 +134,9 @@ fn fit(args: &FitArgs) -> anyhow::Result<()> {
 }
 
 fn classify(args: &ClassifyArgs) -> anyhow::Result<()> {
+    if let Some(path) = &args.out {
+        output::check_writable(path)?;
+    }
     let model: ZoneModel = parse::json(open(&args.model)?)
         .with_context(|| format!("in model {}", args.model.display()))?;
     let set = model.config().feature_set;
