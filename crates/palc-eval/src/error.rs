@@ -41,6 +41,15 @@ pub enum EvalError {
         /// that a report would print twice).
         error: Box<toml::de::Error>,
     },
+    /// A shard file to merge is not one of the evaluation's parts, or parts are
+    /// missing or given twice ([`crate::shard`]).
+    #[error("cannot merge {}: {reason}", path.display())]
+    Shard {
+        /// The shard file (or the first shard directory, for a part missing).
+        path: PathBuf,
+        /// What differs or is missing.
+        reason: String,
+    },
     /// The evaluation was cancelled ([`crate::Progress::cancelled`]) before its
     /// last run; nothing was written.
     #[error("the evaluation was cancelled; no output was written")]

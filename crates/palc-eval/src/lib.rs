@@ -51,6 +51,7 @@ pub mod report;
 pub mod results;
 pub mod runner;
 pub mod safety_report;
+pub mod shard;
 pub mod stats;
 pub mod timing_report;
 pub mod transfer_report;
@@ -83,6 +84,22 @@ pub struct EvalOptions {
     pub quick: bool,
     /// Worker threads, at most [`runner::MAX_JOBS`]; every core when `None`.
     pub jobs: Option<usize>,
+    /// Run only this part of the plan and write its rows to `out/shard.json`
+    /// ([`shard`]); the whole plan when `None`.
+    pub shard: Option<shard::Shard>,
+}
+
+/// What [`merge`] reads and writes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MergeOptions {
+    /// The evaluation config the shards ran.
+    pub config: PathBuf,
+    /// Whether the shards ran its `[quick]` subset.
+    pub quick: bool,
+    /// The shards' output directories, one per shard.
+    pub shards: Vec<PathBuf>,
+    /// Output directory of the merged results.
+    pub out: PathBuf,
 }
 
 impl Default for EvalOptions {
@@ -92,6 +109,7 @@ impl Default for EvalOptions {
             out: PathBuf::from("target/reproduce-paper"),
             quick: false,
             jobs: None,
+            shard: None,
         }
     }
 }
@@ -232,18 +250,113 @@ pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcom
     let evaluation = Evaluation::load(&options.config, options.quick)?;
     let plan = evaluation.plan()?;
     let example_spec = evaluation.example_spec()?;
+    if let Some(shard) = options.shard {
+        return run_shard(&evaluation, &plan, shard, jobs, &options.out, progress);
+    }
     // Everything is written into a staging directory next to `--out`, swapped with it
     // at the end: a run that fails leaves the previous results as they were. An
     // `--out` that exists and is not a directory is refused here, before the runs.
     let staging = Staging::new(&options.out)?;
-    let out = staging.path();
-
     let start = Instant::now();
     let rows = runner::execute(&plan, &evaluation.harness, jobs, progress)?;
     let wall_s = start.elapsed().as_secs_f64();
+    write_results(
+        &evaluation,
+        &example_spec,
+        rows,
+        (wall_s, jobs),
+        staging,
+        &options.out,
+    )
+}
+
+/// Merges the shards of an evaluation ([`shard`]) and writes its outputs as
+/// [`evaluate`] does, as if one machine had made every run.
+///
+/// # Errors
+/// As [`Evaluation::load`], and [`EvalError::Shard`] naming the shard file and
+/// the mismatch, or the runs or shards missing or given twice.
+pub fn merge(options: &MergeOptions) -> Result<Outcome, EvalError> {
+    let evaluation = Evaluation::load(&options.config, options.quick)?;
+    let plan = evaluation.plan()?;
+    let example_spec = evaluation.example_spec()?;
+    let version = manifest::palc_version();
+    let hash = manifest::config_hash(&[&evaluation.texts[0], &evaluation.texts[1]]);
+    let expected = shard::Expected {
+        palc_version: &version,
+        config_sha256: &hash,
+        quick: evaluation.quick,
+    };
+    let (rows, wall_s, threads) = shard::merge_rows(&options.shards, &plan, &expected)?;
+    let staging = Staging::new(&options.out)?;
+    write_results(
+        &evaluation,
+        &example_spec,
+        rows,
+        (wall_s, threads),
+        staging,
+        &options.out,
+    )
+}
+
+/// Makes the runs of `shard` and writes them, with what a merge checks, to
+/// `out/shard.json` (the directory created if needed).
+fn run_shard(
+    evaluation: &Evaluation,
+    plan: &RunPlan,
+    shard: shard::Shard,
+    jobs: usize,
+    out: &Path,
+    progress: &dyn Progress,
+) -> Result<Outcome, EvalError> {
+    let path = out.join(shard::SHARD_FILE);
+    std::fs::create_dir_all(out).map_err(|source| EvalError::Io {
+        action: "create",
+        path: out.to_owned(),
+        source,
+    })?;
+    output::check_writable(&path)?;
+    let executor = shard::ShardExecutor::new(&evaluation.harness, plan, shard);
+    let start = Instant::now();
+    let rows = runner::execute(plan, &executor, jobs, progress)?;
+    let wall_s = start.elapsed().as_secs_f64();
+    let rows: Vec<RunRow> = (rows.into_iter())
+        .filter(|row| executor.is_member(row.spec.id))
+        .collect();
+    let file = shard::ShardFile {
+        format_version: shard::SHARD_FORMAT_VERSION,
+        palc_version: manifest::palc_version(),
+        config_sha256: manifest::config_hash(&[&evaluation.texts[0], &evaluation.texts[1]]),
+        quick: evaluation.quick,
+        shard,
+        plan_runs: plan.len(),
+        threads: jobs,
+        wall_s,
+        rows,
+    };
+    write(&path, &serde_json::to_string(&file)?)?;
+    Ok(Outcome {
+        report: path,
+        runs: file.rows.len(),
+        wall_s,
+        idle: Vec::new(),
+    })
+}
+
+/// Writes every output of an evaluation's `rows` into `staging` and commits it
+/// over `out`; `(wall_s, threads)` are the runs' wall time and threads.
+fn write_results(
+    evaluation: &Evaluation,
+    example_spec: &RunSpec,
+    rows: Vec<RunRow>,
+    (wall_s, jobs): (f64, usize),
+    staging: Staging,
+    out_dir: &Path,
+) -> Result<Outcome, EvalError> {
+    let out = staging.path();
     let example = evaluation
         .harness
-        .example(&example_spec)
+        .example(example_spec)
         .map_err(|e| e.to_string());
 
     let idle = idle::idle_experiments(&rows, &evaluation.expected_refusals);
@@ -309,7 +422,7 @@ pub fn evaluate(options: &EvalOptions, progress: &dyn Progress) -> Result<Outcom
     // The example's files of an earlier run are not carried over when this one has
     // none.
     staging.commit(&["example.json", "fig06-example.svg", "fig06-example.png"])?;
-    let report = options.out.join("REPORT.md");
+    let report = out_dir.join("REPORT.md");
     Ok(Outcome {
         report,
         runs: rows.len(),

@@ -164,6 +164,7 @@ pub fn evaluate<'py>(
             out,
             quick,
             jobs,
+            shard: None,
         };
         let shown = PythonProgress {
             target: progress,

@@ -6,15 +6,19 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
-use clap::Args;
+use clap::{Args, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use palc_eval::{EvalOptions, Progress, RunRow, evaluate};
+use palc_eval::shard::Shard;
+use palc_eval::{EvalOptions, MergeOptions, Outcome, Progress, RunRow, evaluate, merge};
 
 use crate::console::say;
 
 /// Arguments of `palc eval` (and of `cargo xtask reproduce-paper`).
 #[derive(Debug, Args)]
+#[command(args_conflicts_with_subcommands = true)]
 pub struct EvalArgs {
+    #[command(subcommand)]
+    command: Option<EvalCommand>,
     /// Run the config's small `[quick]` subset (about a minute on two cores).
     #[arg(long)]
     quick: bool,
@@ -27,6 +31,34 @@ pub struct EvalArgs {
     /// The evaluation config.
     #[arg(long, default_value = "configs/reproduce.toml")]
     config: PathBuf,
+    /// Run only part `i` of `n` (from 0) of the evaluation and write its runs to
+    /// `OUT/shard.json`, for `palc eval merge` (see docs/scale-out.md).
+    #[arg(long, value_name = "i/n")]
+    shard: Option<Shard>,
+}
+
+#[derive(Debug, Subcommand)]
+enum EvalCommand {
+    /// Merge the shards of an evaluation (`palc eval --shard i/n`) into the
+    /// results one machine would have written.
+    Merge(MergeArgs),
+}
+
+/// Arguments of `palc eval merge`.
+#[derive(Debug, Args)]
+struct MergeArgs {
+    /// The evaluation config the shards ran.
+    #[arg(long, default_value = "configs/reproduce.toml")]
+    config: PathBuf,
+    /// The shards ran the config's `[quick]` subset.
+    #[arg(long)]
+    quick: bool,
+    /// Output directory of the merged results.
+    #[arg(long, default_value = "target/reproduce-paper")]
+    out: PathBuf,
+    /// The shards' output directories, every one of them.
+    #[arg(required = true)]
+    shards: Vec<PathBuf>,
 }
 
 /// Shows progress: a bar with ETA on a terminal, a plain line every 5 % otherwise.
@@ -93,11 +125,15 @@ impl Progress for Shown {
 
 /// Runs `palc eval`.
 pub fn run(args: EvalArgs) -> anyhow::Result<()> {
+    if let Some(EvalCommand::Merge(args)) = args.command {
+        return run_merge(args);
+    }
     let options = EvalOptions {
         config: args.config,
         out: args.out,
         quick: args.quick,
         jobs: args.jobs,
+        shard: args.shard,
     };
     say!(
         "evaluating {}{} on {} threads",
@@ -108,6 +144,37 @@ pub fn run(args: EvalArgs) -> anyhow::Result<()> {
             .map_or_else(|| "all".to_owned(), |j| j.to_string())
     );
     let outcome = evaluate(&options, &Shown::new())?;
+    if let Some(shard) = options.shard {
+        say!(
+            "shard {shard}: {} runs in {:.1} s written to {}",
+            outcome.runs,
+            outcome.wall_s,
+            outcome.report.display()
+        );
+        return Ok(());
+    }
+    finish(&outcome)
+}
+
+/// Runs `palc eval merge`.
+fn run_merge(args: MergeArgs) -> anyhow::Result<()> {
+    let options = MergeOptions {
+        config: args.config,
+        quick: args.quick,
+        shards: args.shards,
+        out: args.out,
+    };
+    say!(
+        "merging {} shards of {}",
+        options.shards.len(),
+        options.config.display()
+    );
+    finish(&merge(&options)?)
+}
+
+/// Says what an evaluation wrote, and fails when one of its experiments
+/// measured nothing.
+fn finish(outcome: &Outcome) -> anyhow::Result<()> {
     say!(
         "{} runs in {:.1} s; report: {}",
         outcome.runs,
