@@ -115,3 +115,28 @@ def test_a_missing_sumo_names_the_package_and_the_extra() -> None:
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert out.startswith("libsumo sumo")
     assert "pip install palc[sumo]" in out
+
+
+class Neutral(palc.User):
+    """The paper's neutral driver written in Python."""
+
+    name = "neutral in Python"
+
+    def nominal(self, scene: palc.Scene) -> palc.LaneChange:
+        start = int((scene["situations"]["time_headway_s"] <= 1.23).argmax())
+        return {"start_s": start * scene["dt"], "duration_s": 2.1}
+
+
+def test_a_python_driver_is_taught_in_closed_loop_among_sumo_traffic(tmp_path: Path) -> None:
+    text = LEARN_CONFIG.read_text().replace(
+        "enabled = false                    # off: one plan", "enabled = true # one plan"
+    )
+    closed = palc.LearnConfig.from_toml_str(text)
+    own = palc.learn(closed, user=Neutral())
+    with sumo.SumoWorld(out=tmp_path, fcd=False) as world:
+        there = palc.learn(closed, user=Neutral(), world=world)
+    assert there.outcome == own.outcome == "personalized"
+    assert there.counted_takeovers == own.counted_takeovers
+    # Re-planned every step: the rehearsal and the drive each place the scene.
+    assert world.placements == 2 * there.lane_changes
+    assert all(r["closed_loop"]["replans"] > 0 for r in there.records)
