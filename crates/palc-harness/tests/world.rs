@@ -1,7 +1,8 @@
 //! The world a lane change is driven in ([`palc_harness::World`]): palc's own
 //! traffic reported through the interface gives the loop's results bit for bit,
-//! open and closed loop, both methods, with and without the safety layer; a
-//! world that fails or loses a vehicle ends the run with an error naming it.
+//! open and closed loop, both methods, with and without the safety layer; the
+//! loop reads the traffic a world reports; a world that fails or loses a vehicle
+//! ends the run with an error naming it.
 
 use palc_harness::{
     LearnConfig, LearningLoop, Method, NoObserver, PalcTraffic, RunResult, UserConfig, World,
@@ -128,4 +129,43 @@ fn a_world_that_fails_or_loses_a_vehicle_ends_the_run_with_its_error() {
             assert!(cause.contains("closed its connection"), "{cause}");
         }
     }
+}
+
+/// palc's own traffic reported 2 m further along the road than it is.
+#[derive(Debug, Default)]
+struct Shifted(PalcTraffic);
+
+impl World for Shifted {
+    fn name(&self) -> &str {
+        "shifted"
+    }
+
+    fn place(&mut self, scene: &Scene, dt: f64) -> Result<(), WorldError> {
+        self.0.place(scene, dt)
+    }
+
+    fn step(&mut self, ego: &EgoState) -> Result<Vec<Observed>, WorldError> {
+        let mut observed = self.0.step(ego)?;
+        for report in &mut observed {
+            report.s += 2.0;
+        }
+        Ok(observed)
+    }
+}
+
+#[test]
+fn the_loop_reads_the_traffic_the_world_reports() {
+    let config = config(Method::Palc, "neutral", false, false);
+    let own = run(&config, None).unwrap();
+    let shifted = run(&config, Some(Box::new(Shifted::default()))).unwrap();
+    let (own, shifted) = (&own.records[0], &shifted.records[0]);
+    assert_eq!(own.driven_l, shifted.driven_l);
+    // Every gap to a vehicle ahead is 2 m longer after the first step.
+    let gap = |r: &palc_harness::LaneChangeRecord| r.safety.min_gap_preceding_m.unwrap();
+    assert!(
+        (gap(shifted) - gap(own) - 2.0).abs() < 1e-6,
+        "{} {}",
+        gap(shifted),
+        gap(own)
+    );
 }
