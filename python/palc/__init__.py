@@ -22,6 +22,8 @@ from palc._errors import (
     PlanError,
     ScenarioRefused,
     ShapeError,
+    SimulatorError,
+    SimulatorMissing,
     SolverFailed,
     ZoneError,
 )
@@ -41,6 +43,7 @@ from palc._palc import (
 )
 from palc._runs import read_runs
 from palc._user import LaneChange, Scene, User
+from palc._world import World
 
 __all__ = [
     "STAGE_WEIGHT_NAMES",
@@ -58,8 +61,11 @@ __all__ = [
     "ScenarioRefused",
     "Scene",
     "ShapeError",
+    "SimulatorError",
+    "SimulatorMissing",
     "SolverFailed",
     "User",
+    "World",
     "ZoneError",
     "ZoneModel",
     "__version__",

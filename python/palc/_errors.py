@@ -17,6 +17,8 @@ __all__ = [
     "ScenarioRefused",
     "ZoneError",
     "ShapeError",
+    "SimulatorError",
+    "SimulatorMissing",
 ]
 
 
@@ -57,3 +59,26 @@ class ZoneError(PalcError):
 class ShapeError(PalcError, ValueError):
     """An array argument of the wrong shape, or not convertible to float64; `field`
     names the argument."""
+
+
+class SimulatorError(PalcError):
+    """The simulator a lane change was driven in failed (it died, lost a vehicle, or
+    reported a state out of range); the run ends with this error."""
+
+
+class SimulatorMissing(PalcError, ImportError):
+    """A simulator bridge whose simulator is not installed; the message names the
+    missing package and the ``pip install palc[...]`` line that installs it."""
+
+    #: The missing package, e.g. ``highway-env``.
+    package: Optional[str] = None
+    #: The extra that installs it, e.g. ``highway``.
+    extra: Optional[str] = None
+
+    def __init__(self, package: str, extra: str) -> None:
+        super().__init__(
+            f"this bridge needs the Python package `{package}`, which is not installed: "
+            f"`pip install palc[{extra}]` installs it"
+        )
+        self.package = package
+        self.extra = extra

@@ -180,7 +180,11 @@ class LearningLoop:
     """The lesson-learning loop, lane change by lane change."""
 
     def __new__(
-        cls, config: LearnConfig, user: Optional[Any] = None, experience: Optional[Experience] = None
+        cls,
+        config: LearnConfig,
+        user: Optional[Any] = None,
+        experience: Optional[Experience] = None,
+        world: Optional[Any] = None,
     ) -> LearningLoop: ...
     def __iter__(self) -> LearningLoop: ...
     def __next__(self) -> dict[str, Any]: ...
@@ -189,7 +193,10 @@ class LearningLoop:
     def result(self) -> LearnResult: ...
 
 def learn(
-    config: LearnConfig, experience: Optional[Experience] = None, user: Optional[Any] = None
+    config: LearnConfig,
+    experience: Optional[Experience] = None,
+    user: Optional[Any] = None,
+    world: Optional[Any] = None,
 ) -> LearnResult: ...
 
 

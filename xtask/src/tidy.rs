@@ -413,14 +413,21 @@ fn code_name(span: &str) -> Option<CodeName> {
     (camel || screaming || snake).then(|| CodeName::Identifiers(vec![span.to_owned()]))
 }
 
-/// Every identifier of the Rust sources of `crates/` and `xtask/`, and every `.rs` path.
+/// Every identifier of the Rust sources of `crates/` and `xtask/` and of the Python
+/// package's sources (`python/palc/*.py`, the simulator bridges), and every `.rs` path.
 fn rust_names() -> (std::collections::BTreeSet<String>, Vec<String>) {
     let mut files = Vec::new();
     rust_files(&project_root().join("crates"), &mut files);
     rust_files(&project_root().join("xtask"), &mut files);
+    let python = fs::read_dir(project_root().join("python/palc"))
+        .into_iter()
+        .flatten();
+    let python: Vec<PathBuf> = (python.flatten().map(|entry| entry.path()))
+        .filter(|path| path.extension().is_some_and(|ext| ext == "py"))
+        .collect();
     let mut identifiers = std::collections::BTreeSet::new();
     // This file's own examples do not count as code.
-    for path in files.iter().filter(|path| !path.ends_with("tidy.rs")) {
+    for path in (files.iter().chain(&python)).filter(|path| !path.ends_with("tidy.rs")) {
         for word in read(path).split(|c: char| !(c.is_ascii_alphanumeric() || c == '_')) {
             if is_identifier(word) {
                 identifiers.insert(word.to_owned());

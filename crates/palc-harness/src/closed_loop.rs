@@ -44,6 +44,7 @@ use crate::guard::{drive_states, guarded_step};
 use crate::record::ClosedLoopStats;
 use crate::safety::{SafetyMetrics, SafetyMonitor, Violation};
 use crate::setup::Setup;
+use crate::world::{Traffic, World};
 
 pub use crate::config::ClosedLoopConfig;
 
@@ -186,6 +187,24 @@ impl ClosedLoop {
         first: &Plan,
         fell_back: bool,
     ) -> Result<(Plan, ClosedLoopStats), HarnessError> {
+        self.drive_in(setup, experience, options, first, fell_back, None)
+    }
+
+    /// As [`ClosedLoop::drive`], in `world`'s traffic when given: the world places
+    /// the scene at the trigger and moves the other vehicles, and every re-plan
+    /// predicts them from the states it reported ([`crate::World`]).
+    ///
+    /// # Errors
+    /// Those of [`ClosedLoop::drive`], and the world's failure.
+    pub fn drive_in(
+        &self,
+        setup: &Setup,
+        experience: &Experience,
+        options: &AggregatorOptions,
+        first: &Plan,
+        fell_back: bool,
+        world: Option<&mut dyn World>,
+    ) -> Result<(Plan, ClosedLoopStats), HarnessError> {
         let k = setup.horizon;
         let mut stats = ClosedLoopStats {
             fallback_step: fell_back.then_some(0),
@@ -196,7 +215,9 @@ impl ClosedLoop {
         } else {
             Policy::Learned
         };
+        let mut traffic = Traffic::of(world);
         let mut scene = setup.scene.clone();
+        traffic.place(&scene, setup.dt)?;
         let mut current = first.clone();
         // The step of the trajectory at which `current` starts.
         let mut start = 0;
@@ -220,7 +241,7 @@ impl ClosedLoop {
                 states.push(next);
                 lateral_violation
                     .push(current.lateral_violation.get(j + 1).copied().unwrap_or(0.0));
-                scene.step(setup.dt, setup.ego_state(&next))?;
+                traffic.advance(&mut scene, setup.dt, setup.ego_state(&next))?;
             }
             step = until;
             // Re-plan while at least two steps remain.

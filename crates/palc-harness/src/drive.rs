@@ -9,6 +9,7 @@ use crate::guard::{drive_states, guarded_step, guarded_user_acceleration};
 use crate::record::Takeover;
 use crate::safety::{SafetyMetrics, SafetyMonitor};
 use crate::setup::{Setup, situation, target_gaps_safe};
+use crate::world::{Traffic, World};
 use palc_user::{Expectation, ExpectedLaneChange, TakeoverCause, User, max_deviation};
 
 /// The planning problem of this scenario with the given weights and lateral bounds.
@@ -112,14 +113,32 @@ pub fn execute(
     user: &dyn User,
     expectation: &Expectation,
 ) -> Result<Drive, HarnessError> {
+    execute_in(setup, plan, user, expectation, None)
+}
+
+/// As [`execute`], in `world`'s traffic when given (see [`World`]): the world
+/// places the scene at the trigger and moves the other vehicles at every step.
+///
+/// The user judges step `i` as the system would drive it, with the other vehicles
+/// one step on from the mirror by palc's models (in palc's own traffic, exactly
+/// where the step moves them: they react to the ego's previous state only), so
+/// that a takeover at step `i` drives step `i` already.
+pub fn execute_in(
+    setup: &Setup,
+    plan: Plan,
+    user: &dyn User,
+    expectation: &Expectation,
+    world: Option<&mut dyn World>,
+) -> Result<Drive, HarnessError> {
     let k = setup.horizon;
     let dt = setup.dt;
     let planned_l: Vec<f64> = plan.states.iter().map(|x| x.l).collect();
     let expected_l = expectation.lateral(k);
-    let judged = judge(setup, user, expectation, &plan.states)?;
-    let takeover_step = judged.map(|(step, _)| step);
+    let mut judged: Option<(usize, TakeoverCause)> = None;
 
+    let mut traffic = Traffic::of(world);
     let mut scene = setup.scene.clone();
+    traffic.place(&scene, dt)?;
     let mut system = SafetyMonitor::new(setup.safety, &scene, setup.target_l);
     let mut by_user_monitor = system.clone();
     let mut driven: Vec<State> = Vec::with_capacity(k + 1);
@@ -137,28 +156,44 @@ pub fn execute(
     // target-lane vehicle alongside: its lane change resumes this much later.
     let mut held = 0;
     for i in 0..=k {
-        let by_user = takeover_step.is_some_and(|step| i >= step);
-        // The system's state at this step, while it drives (and at the takeover).
-        let by_system = (takeover_step.is_none_or(|step| i <= step)).then(|| match driven.last() {
-            None => plan.states[0],
-            Some(previous) => guarded_step(
-                setup,
-                &scene,
-                previous,
-                &plan.states[i - 1],
-                &plan.states[i],
-            ),
-        });
-        if takeover_step == Some(i) {
-            at_takeover = by_system.unwrap_or(at_takeover);
+        // The system's state at this step, while it drives, and the user's look at it.
+        if judged.is_none() {
+            let by_system = match driven.last() {
+                None => plan.states[0],
+                Some(previous) => guarded_step(
+                    setup,
+                    &scene,
+                    previous,
+                    &plan.states[i - 1],
+                    &plan.states[i],
+                ),
+            };
+            let seen = if i == 0 {
+                situation(&scene)
+            } else {
+                let mut ahead = scene.clone();
+                ahead.step(dt, setup.ego_state(&by_system))?;
+                situation(&ahead)
+            };
+            judged = (user.takes_over(expectation, i, &by_system, &seen)).map(|cause| (i, cause));
+            at_takeover = by_system;
+            if judged.is_none() {
+                if i > 0 {
+                    traffic.advance(&mut scene, dt, setup.ego_state(&by_system))?;
+                }
+                system.observe(i, &scene);
+                preceding.push(frame(scene.preceding()));
+                adjacent.push(frame(scene.adjacent()));
+                driven.push(by_system);
+                continue;
+            }
         }
-        let state = match (by_user, driven.last()) {
-            (false, _) => by_system.unwrap_or(plan.states[i]),
-            (true, None) => State {
+        let state = match driven.last() {
+            None => State {
                 l: expected_l[0],
                 ..plan.states[0]
             },
-            (true, Some(previous)) => {
+            Some(previous) => {
                 let (mut next, differs) = driving.step(&scene, previous, i, held);
                 user_speed_differs |= differs;
                 if driving.holds_before_entering(&scene, previous, &next, i, held)? {
@@ -169,17 +204,14 @@ pub fn execute(
             }
         };
         if i > 0 {
-            scene.step(dt, setup.ego_state(&state))?;
+            traffic.advance(&mut scene, dt, setup.ego_state(&state))?;
         }
-        if by_user {
-            by_user_monitor.observe(i, &scene);
-        } else {
-            system.observe(i, &scene);
-        }
+        by_user_monitor.observe(i, &scene);
         preceding.push(frame(scene.preceding()));
         adjacent.push(frame(scene.adjacent()));
         driven.push(state);
     }
+    let takeover_step = judged.as_ref().map(|(step, _)| *step);
     // The user's heading follows its lateral path.
     if let Some(step) = takeover_step {
         for i in step..k {

@@ -64,6 +64,16 @@ pub enum HarnessError {
         #[source]
         source: Box<dyn std::error::Error + Send + Sync>,
     },
+    /// The simulator a lane change was driven in failed or reported what cannot be
+    /// used (a vehicle missing or out of range).
+    #[error("world `{world}` failed")]
+    World {
+        /// The world's name.
+        world: String,
+        /// What failed.
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
     /// The TOML text does not parse or does not match the schema (unknown field, missing
     /// field, wrong type); the message names the field path, the line and the column.
     #[error("cannot parse the config: {}{error}", at_field(path))]

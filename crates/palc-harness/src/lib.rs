@@ -55,6 +55,7 @@ mod scene_lessons;
 mod setup;
 mod standard_alc;
 mod violation;
+mod world;
 
 /// The users: the [`User`] trait, its plain view of a scenario and the built-in
 /// simulated users (the `palc-user` crate).
@@ -70,6 +71,7 @@ pub use record::{LaneChangeRecord, Outcome, RunResult, RunSummary};
 pub use refusal::Refusal;
 pub use scenario::prepare;
 pub use setup::Setup;
+pub use world::{PalcTraffic, World, WorldError};
 
 /// The loop's building blocks, for those who drive their own loop or test one
 /// part of it: the planning problem of a scenario, the execution of a plan with a
@@ -78,7 +80,7 @@ pub use setup::Setup;
 pub mod advanced {
     pub use crate::acc::acc_leader;
     pub use crate::carry::Names;
-    pub use crate::drive::{Drive, execute, judge, plan_safety, problem};
+    pub use crate::drive::{Drive, execute, execute_in, judge, plan_safety, problem};
     pub use crate::method::{Driver, label};
     pub use crate::personalization::{
         Demonstration, LessonPaths, Personalization, RelativeOnset, Replay, SceneAveraged,

@@ -236,6 +236,7 @@ pub(crate) fn classify_harness(error: &HarnessError) -> Raise {
             kind: Some(refusal.kind()),
             ..Raise::class("ScenarioRefused")
         },
+        HarnessError::World { .. } => Raise::class("SimulatorError"),
         HarnessError::TrafficConfig(e) => classify_traffic(e),
         HarnessError::Planner(e) => classify_plan(e),
         HarnessError::Zone(e) => classify_zone(e),

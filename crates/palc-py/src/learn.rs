@@ -19,6 +19,7 @@ use crate::arrays::to_vector;
 use crate::convert::{serialize, to_json, to_toml};
 use crate::errors::{self, Raise, guard};
 use crate::user::{PythonUser, Raised};
+use crate::world::PythonWorld;
 
 /// The config of one learning run (`palc_harness::LearnConfig`), validated.
 #[pyclass(module = "palc", frozen)]
@@ -288,12 +289,14 @@ impl LearnResult {
     }
 }
 
-/// The user of a run: the config's built-in simulated user, or a Python driver.
+/// The loop of a run: the config's built-in simulated user, or a Python driver; in
+/// palc's own traffic, or in a simulator driven from Python (`world`).
 fn loop_for(
     py: Python<'_>,
     config: &palc_harness::LearnConfig,
     experience: Option<&RustExperience>,
     user: Option<Py<PyAny>>,
+    world: Option<Py<PyAny>>,
     raised: &Raised,
 ) -> PyResult<palc_harness::LearningLoop> {
     let made = match user {
@@ -304,7 +307,11 @@ fn loop_for(
             py.detach(|| palc_harness::LearningLoop::with_user(config, experience, Box::new(user)))
         }
     };
-    made.map_err(|e| harness_or_raised(py, &e, raised))
+    let made = made.map_err(|e| harness_or_raised(py, &e, raised))?;
+    Ok(match world {
+        None => made,
+        Some(object) => made.in_world(Box::new(PythonWorld::new(py, object, raised.clone()))),
+    })
 }
 
 /// The exception of a harness error, or the Python driver's own exception that
@@ -339,20 +346,22 @@ fn finish(
 
 /// Runs the lesson-learning loop of ``config`` (as ``palc learn``), starting from
 /// ``experience`` if given, with the config's built-in simulated user or with
-/// ``user``, a driver written in Python (a ``palc.User``). The GIL is released
-/// while the loop runs, and taken again for each call of a Python driver.
+/// ``user``, a driver written in Python (a ``palc.User``), in palc's own traffic or
+/// in ``world``, a simulator driven from Python (a ``palc.World``). The GIL is
+/// released while the loop runs, and taken again for each call into Python.
 #[pyfunction]
-#[pyo3(signature = (config, experience = None, user = None))]
+#[pyo3(signature = (config, experience = None, user = None, world = None))]
 pub fn learn(
     py: Python<'_>,
     config: &LearnConfig,
     experience: Option<&Experience>,
     user: Option<Py<PyAny>>,
+    world: Option<Py<PyAny>>,
 ) -> PyResult<LearnResult> {
     guard(py, "learn", || {
         let raised = Raised::default();
         let experience = experience.map(|e| &e.inner);
-        let learning = loop_for(py, &config.inner, experience, user, &raised)?;
+        let learning = loop_for(py, &config.inner, experience, user, world, &raised)?;
         let result = py.detach(|| learning.run(&mut NoObserver));
         finish(py, result, &raised)
     })
@@ -401,19 +410,21 @@ impl LearningLoop {
 #[pymethods]
 impl LearningLoop {
     /// Prepares the run of ``config`` as ``learn`` does (the scenario, the planner, the
-    /// first plan), with the built-in user or the Python driver ``user``.
+    /// first plan), with the built-in user or the Python driver ``user``, in palc's
+    /// own traffic or in the Python simulator ``world``.
     #[new]
-    #[pyo3(signature = (config, user = None, experience = None))]
+    #[pyo3(signature = (config, user = None, experience = None, world = None))]
     fn new(
         py: Python<'_>,
         config: &LearnConfig,
         user: Option<Py<PyAny>>,
         experience: Option<&Experience>,
+        world: Option<Py<PyAny>>,
     ) -> PyResult<LearningLoop> {
         guard(py, "LearningLoop()", || {
             let raised = Raised::default();
             let experience = experience.map(|e| &e.inner);
-            let inner = loop_for(py, &config.inner, experience, user, &raised)?;
+            let inner = loop_for(py, &config.inner, experience, user, world, &raised)?;
             Ok(LearningLoop {
                 inner: Mutex::new(Some(inner)),
                 raised,

@@ -9,7 +9,8 @@
 //! - `zone.rs`: `ZoneModel`, the zone filter's GDA under scikit-learn's names;
 //! - `learn.rs`: `LearnConfig`, `Experience`, `learn`, `LearningLoop` and
 //!   `LearnResult`, the lesson-learning loop with a built-in simulated user or a
-//!   driver written in Python (`user.rs`);
+//!   driver written in Python (`user.rs`), in palc's own traffic or in a simulator
+//!   driven from Python (`world.rs`);
 //! - `evaluate.rs`: `evaluate`, an evaluation config run as `palc eval` runs it;
 //! - `errors.rs`: every Rust error as a `palc.PalcError` subclass with its field,
 //!   value, bound and cause chain, and the guard that turns a panic into one;
@@ -38,6 +39,7 @@ mod evaluate;
 mod learn;
 mod planner;
 mod user;
+mod world;
 mod zone;
 
 /// The native part of the `palc` package; import `palc` instead.

@@ -170,6 +170,25 @@ pub enum SceneError {
         /// `preceding` or `adjacent`.
         role: &'static str,
     },
+    /// A simulator outside palc reported a vehicle state that cannot be used.
+    #[error("observed vehicle {id}: `{field}` = {value:?} is out of range: it must be {bound}")]
+    InvalidObservation {
+        /// The vehicle's identifier as reported.
+        id: u32,
+        /// The field.
+        field: &'static str,
+        /// The value reported.
+        value: f64,
+        /// The allowed range, in words.
+        bound: &'static str,
+    },
+    /// A simulator outside palc did not report a background vehicle of the scene
+    /// (it left the simulation, or the simulator lost it).
+    #[error("vehicle {id} of the scene was not reported by the simulator after the step")]
+    MissingObservation {
+        /// The vehicle's identifier.
+        id: u32,
+    },
     /// A prediction horizon longer than allowed.
     #[error("prediction horizon of {steps} steps is too long: at most {max} steps")]
     HorizonTooLong {

@@ -37,6 +37,7 @@ mod config;
 mod error;
 mod idm;
 mod lag;
+mod observed;
 mod platoon;
 mod prediction;
 mod road;
@@ -53,6 +54,7 @@ pub use config::{
 };
 pub use error::{ConfigError, SceneError};
 pub use idm::{BallisticStep, DesiredGap, IdmParams, MIN_INTERACTION_GAP, ballistic_step};
+pub use observed::Observed;
 pub use prediction::{MAX_HORIZON_STEPS, Prediction, PredictionModel};
 pub use road::{Lane, MAX_LANES, Road};
 pub use scene::{MAX_DT, MAX_VEHICLES, Scene};

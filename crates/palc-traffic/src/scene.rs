@@ -347,7 +347,7 @@ pub(crate) fn check_dt(dt: f64) -> Result<(), SceneError> {
     }
 }
 
-fn check_ego(ego: &EgoState) -> Result<(), SceneError> {
+pub(crate) fn check_ego(ego: &EgoState) -> Result<(), SceneError> {
     let finite = [("s", ego.s), ("l", ego.l), ("heading", ego.heading)];
     if let Some(&(field, value)) = finite.iter().find(|(_, value)| !value.is_finite()) {
         return Err(SceneError::InvalidEgoState {

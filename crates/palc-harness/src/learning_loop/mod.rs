@@ -28,7 +28,7 @@ use crate::HarnessError;
 use crate::carry::{Names, rehearse};
 use crate::closed_loop::ClosedLoop;
 use crate::config::{LearnConfig, StoppingConfig};
-use crate::drive::{Drive, execute, judge, plan_safety, problem};
+use crate::drive::{Drive, execute_in, judge, plan_safety, problem};
 use crate::lesson::{lesson, scenes, zone_feature_set};
 use crate::method::Method;
 use crate::observer::{LessonEvent, Observer};
@@ -38,6 +38,7 @@ use crate::refusal::Refusal;
 use crate::safety::{SafetyMetrics, Violation};
 use crate::scenario::{aggregator_options, prepare_for};
 use crate::setup::Setup;
+use crate::world::World;
 
 use run_state::{RunState, termination};
 
@@ -94,6 +95,8 @@ struct Scenario {
     fallback: Option<(Plan, SafetyMetrics)>,
     /// With `[planning.closed_loop]` on, the closed-loop driver.
     closed_loop: Option<ClosedLoop>,
+    /// The simulator the lane changes are driven in, when not palc's own traffic.
+    world: Option<Box<dyn World>>,
 }
 
 /// What the method has learned and will drive next.
@@ -225,6 +228,7 @@ impl LearningLoop {
                 template,
                 fallback,
                 closed_loop,
+                world: None,
             },
             learner: Learner {
                 planner,
@@ -235,6 +239,16 @@ impl LearningLoop {
             },
             run: RunState::default(),
         })
+    }
+
+    /// This run with every lane change driven in `world`'s traffic instead of
+    /// palc's own: the world places the scenario's scene at the trigger, moves the
+    /// other vehicles, and the loop (plans, the user, lessons, safety) reads them
+    /// as it reads its own ([`World`]).
+    #[must_use]
+    pub fn in_world(mut self, world: Box<dyn World>) -> Self {
+        self.scenario.world = Some(world);
+        self
     }
 
     /// Drives one lane change with the current plan and, when the user takes over
@@ -338,12 +352,16 @@ impl LearningLoop {
         let (plan, planned_safety, refusal) = self.checked_plan()?;
         let (plan, closed_loop) = match &self.scenario.closed_loop {
             Some(driver) => {
-                let (plan, stats) = driver.drive(
+                let (plan, stats) = driver.drive_in(
                     &self.scenario.setup,
                     &self.learner.experience,
                     &self.policy.options,
                     &plan,
                     refusal.is_some(),
+                    self.scenario
+                        .world
+                        .as_deref_mut()
+                        .map(|w| w as &mut dyn World),
                 )?;
                 (plan, Some(stats))
             }
@@ -425,7 +443,8 @@ impl LearningLoop {
         } else {
             false
         };
-        let drive = execute(setup, plan, user, &expectation)?;
+        let world = scenario.world.as_deref_mut().map(|w| w as &mut dyn World);
+        let drive = execute_in(setup, plan, user, &expectation, world)?;
         Ok((drive, ceiling))
     }
 
