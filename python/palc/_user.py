@@ -90,3 +90,13 @@ class User:
         a subclass overrides it; otherwise the loop applies the run's deviation rule
         (``planning.takeover_threshold_m``) itself, and this default answers no."""
         return False
+
+    def acceleration_after_takeover(self, step: int, speed: float, acc: float) -> float:
+        """The driver's longitudinal acceleration (m/s²) at ``step`` after it took
+        over, driving at ``speed`` (m/s), when the ego's ACC would command ``acc``
+        (which keeps the distance to whatever is ahead). Called only when a subclass
+        overrides it, and bounded by the ego's limits as the built-in users' is;
+        otherwise the loop applies the built-in rule (the ACC's command), which is
+        what this default returns. A value that is not a finite number raises
+        ``ValueError`` to the caller of the run."""
+        return acc

@@ -115,3 +115,26 @@ def test_an_exception_in_takes_over_surfaces_with_its_traceback() -> None:
     learning = palc.LearningLoop(config(), user=Nervous())
     with pytest.raises(ValueError, match="no rule for step"):
         next(learning)
+
+
+def test_the_acceleration_after_a_takeover_is_the_python_drivers() -> None:
+    calls: list[tuple[int, float, float]] = []
+
+    class Follows(Neutral):
+        def acceleration_after_takeover(self, step: int, speed: float, acc: float) -> float:
+            calls.append((step, speed, acc))
+            return acc
+
+    built_in = palc.learn(config())
+    result = palc.learn(config(), user=Follows())
+    assert result.takeovers >= 1 and calls, "no takeover, so no acceleration asked"
+    assert all(np.isfinite(speed) and np.isfinite(acc) for _, speed, acc in calls)
+    # Answering the ACC's command is the built-in rule for this user: the same run.
+    assert result.summary == built_in.summary
+
+    class Brakes(Neutral):
+        def acceleration_after_takeover(self, step: int, speed: float, acc: float) -> float:
+            return float("nan")
+
+    with pytest.raises(ValueError, match="finite acceleration"):
+        palc.learn(config(), user=Brakes())

@@ -63,6 +63,9 @@ pub(crate) struct PythonUser {
     raised: Raised,
     /// Whether the object overrides `takes_over` (else the deviation rule decides).
     own_takeover: bool,
+    /// Whether the object overrides `acceleration_after_takeover` (else the
+    /// built-in users' rule decides).
+    own_acceleration: bool,
 }
 
 /// Whether `object`'s class defines `method` itself rather than inheriting
@@ -90,12 +93,14 @@ impl PythonUser {
             .or_else(|_| object.bind(py).get_type().name().map(|n| n.to_string()))
             .unwrap_or_else(|_| "python".to_owned());
         let own_takeover = overrides(py, object.bind(py), "takes_over");
+        let own_acceleration = overrides(py, object.bind(py), "acceleration_after_takeover");
         PythonUser {
             object,
             name,
             deviation_m,
             raised,
             own_takeover,
+            own_acceleration,
         }
     }
 
@@ -148,15 +153,7 @@ impl User for PythonUser {
         seen: &Situation,
     ) -> Option<TakeoverCause> {
         let expected_l = expectation.states.get(step).map_or(ego.l, |x| x.l);
-        let rule = || {
-            let lane_change = &expectation.lane_change;
-            (expectation.takeover).judge(
-                ego.l,
-                expected_l,
-                (lane_change.from_l, lane_change.to_l),
-                seen,
-            )
-        };
+        let rule = || expectation.judge(step, ego, seen);
         if !self.own_takeover || self.raised.lock().map_or(true, |r| r.is_some()) {
             return rule();
         }
@@ -183,6 +180,43 @@ impl User for PythonUser {
                     rule()
                 }
             }
+        })
+    }
+
+    /// The Python driver's `acceleration_after_takeover(step, speed, acc)` if it
+    /// defines one: a finite number (m/s²), which the loop bounds by the ego's limits
+    /// as it does the built-in users'. Otherwise, or once the driver has raised or
+    /// answered something else, the built-in users' rule.
+    fn acceleration_after_takeover(
+        &self,
+        expectation: &Expectation,
+        step: usize,
+        speed: f64,
+        acc: f64,
+    ) -> f64 {
+        let built_in = || expectation.acceleration_after_takeover(step, speed, acc);
+        if !self.own_acceleration || self.raised.lock().map_or(true, |r| r.is_some()) {
+            return built_in();
+        }
+        Python::attach(|py| {
+            let answer = (|| -> PyResult<f64> {
+                let value: f64 = (self.object.bind(py))
+                    .call_method1("acceleration_after_takeover", (step, speed, acc))?
+                    .extract()?;
+                if !value.is_finite() {
+                    return Err(pyo3::exceptions::PyValueError::new_err(format!(
+                        "acceleration_after_takeover returned {value:?} at step {step}, \
+                         expected a finite acceleration in m/s²"
+                    )));
+                }
+                Ok(value)
+            })();
+            answer.unwrap_or_else(|error| {
+                if let Ok(mut slot) = self.raised.lock() {
+                    slot.get_or_insert(error);
+                }
+                built_in()
+            })
         })
     }
 }

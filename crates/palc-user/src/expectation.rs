@@ -192,6 +192,35 @@ pub struct Expectation {
 }
 
 impl Expectation {
+    /// The expectation's own longitudinal acceleration at `step` after a takeover,
+    /// driving at `speed`, when the ego ACC would command `acc`: the default of
+    /// [`crate::User::acceleration_after_takeover`] (the ACC's, or, for an
+    /// accelerating user from its start, the speed gap to the target lane times
+    /// 1/s within its largest acceleration, never above the ACC's).
+    pub fn acceleration_after_takeover(&self, step: usize, speed: f64, acc: f64) -> f64 {
+        match self.speed {
+            SpeedRule::Accelerating {
+                max_acceleration_mps2,
+            } if step >= self.start_step => (self.target_speed - speed)
+                .clamp(-max_acceleration_mps2, max_acceleration_mps2)
+                .min(acc),
+            _ => acc,
+        }
+    }
+
+    /// The expectation's own [`TakeoverRule`] at `step` of a drive, the ego at
+    /// `ego` (plan frame) seeing `seen`: the default of [`crate::User::takes_over`].
+    pub fn judge(&self, step: usize, ego: &State, seen: &Situation) -> Option<TakeoverCause> {
+        let expected_l = self.states.get(step).map_or(ego.l, |x| x.l);
+        let lane_change = &self.lane_change;
+        self.takeover.judge(
+            ego.l,
+            expected_l,
+            (lane_change.from_l, lane_change.to_l),
+            seen,
+        )
+    }
+
     /// Expected lateral positions at steps `0..=k`.
     pub fn lateral(&self, k: usize) -> Vec<f64> {
         self.states.iter().take(k + 1).map(|x| x.l).collect()

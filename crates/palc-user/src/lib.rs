@@ -141,14 +141,7 @@ pub trait User: std::fmt::Debug + Send {
         ego: &State,
         seen: &Situation,
     ) -> Option<TakeoverCause> {
-        let expected_l = expectation.states.get(step).map_or(ego.l, |x| x.l);
-        let lane_change = &expectation.lane_change;
-        expectation.takeover.judge(
-            ego.l,
-            expected_l,
-            (lane_change.from_l, lane_change.to_l),
-            seen,
-        )
+        expectation.judge(step, ego, seen)
     }
 
     /// The user's longitudinal acceleration at `step` after a takeover, driving
@@ -163,14 +156,7 @@ pub trait User: std::fmt::Debug + Send {
         speed: f64,
         acc: f64,
     ) -> f64 {
-        match expectation.speed {
-            SpeedRule::Accelerating {
-                max_acceleration_mps2,
-            } if step >= expectation.start_step => (expectation.target_speed - speed)
-                .clamp(-max_acceleration_mps2, max_acceleration_mps2)
-                .min(acc),
-            _ => acc,
-        }
+        expectation.acceleration_after_takeover(step, speed, acc)
     }
 }
 
