@@ -822,3 +822,22 @@ fn outputs_that_cannot_be_written_are_refused_before_the_work() {
         "a file was left"
     );
 }
+
+/// A user file whose user refuses the scenario at run time was not named: the
+/// message said what the user refused, not which file it came from.
+#[test]
+fn a_user_refusal_at_run_time_names_the_user_file() {
+    let dir = scratch("user-run-time");
+    std::fs::write(
+        dir.join("picky.toml"),
+        "[user]\nstyle = \"neutral\"\n[user.family]\nmin_lead_gap_s = 9.0\n",
+    )
+    .unwrap();
+    for args in [
+        vec!["learn", "--user", "picky.toml"],
+        vec!["user", "expect", "--user", "picky.toml", "--out", "e.csv"],
+    ] {
+        let output = palc(&args, &dir);
+        fails_with(&output, &["with the user of picky.toml", "lead 9.00 s"]);
+    }
+}

@@ -16,6 +16,18 @@ use crate::console::say;
 /// The default config, compiled in so that `palc learn` alone works anywhere.
 const DEFAULT_CONFIG: &str = include_str!("../../../../configs/learn.toml");
 
+impl ScenarioArgs {
+    /// Where the run's user comes from, for an error found while it runs: the
+    /// `--user` file, else the config.
+    pub(crate) fn whose_user(&self) -> String {
+        match (&self.user, &self.config) {
+            (Some(user), _) => format!("with the user of {}", user.display()),
+            (None, Some(config)) => format!("with the config {}", config.display()),
+            (None, None) => "with the built-in config (configs/learn.toml)".to_owned(),
+        }
+    }
+}
+
 /// The scenario and user of a run: a config and what the command line overrides.
 #[derive(Debug, Args)]
 pub struct ScenarioArgs {
@@ -174,7 +186,8 @@ pub fn run_learn(args: LearnArgs) -> anyhow::Result<()> {
         None => None,
     };
     say!("{} ({} method)", config.label(), config.method.name());
-    let result = run(&config, experience.as_ref(), &mut Printer)?;
+    let result = run(&config, experience.as_ref(), &mut Printer)
+        .with_context(|| args.scenario.whose_user())?;
     let duration_s = config.planning.standard_alc.lane_change_duration_s;
     if let Some(estimate) = DriverEstimate::from_onsets(&result.experience.onsets, duration_s) {
         say!("the driver, as palc believes: {}", estimate.describe());

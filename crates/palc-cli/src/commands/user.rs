@@ -44,7 +44,8 @@ pub fn run(args: UserArgs) -> anyhow::Result<()> {
 fn expect(args: ExpectArgs) -> anyhow::Result<()> {
     output::check_writable(&args.out)?;
     let config = load_config(&args.scenario)?;
-    let (setup, expectation) = palc_harness::advanced::expectation(&config)?;
+    let (setup, expectation) =
+        palc_harness::advanced::expectation(&config).with_context(|| args.scenario.whose_user())?;
     let lane_change = &expectation.lane_change;
     let mut csv = String::from("step,time_s,s_m,v_mps,l_m,phi_rad,phase\n");
     for (i, state) in expectation
