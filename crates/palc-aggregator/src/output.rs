@@ -65,7 +65,7 @@ pub fn write_with(
     })
 }
 
-/// Checks, before any work, that [`write`] could write `path`: it is not a
+/// Checks, before any work, that [`write()`] could write `path`: it is not a
 /// directory, its directory exists, and a file can be created there (a temporary
 /// one, removed at once). A command calls it for each output it was given, so that
 /// a bad `--out` is refused in a second rather than after a run of minutes.
