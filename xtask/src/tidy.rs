@@ -210,6 +210,16 @@ const DEPENDENCY_RULES: &[(&str, &[&str], bool)] = &[
         ],
         true,
     ),
+    (
+        "palc-drive",
+        &[
+            "palc-traffic",
+            "palc-planner",
+            "palc-aggregator",
+            "palc-harness",
+        ],
+        true,
+    ),
 ];
 
 #[test]

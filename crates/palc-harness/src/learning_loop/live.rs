@@ -7,7 +7,7 @@
 use crate::HarnessError;
 use crate::live::{LiveDriver, LiveLaneChange, LiveLimits, LiveStatus, system::SystemDriver};
 use crate::observer::Observer;
-use crate::record::LaneChangeRecord;
+use crate::record::{LaneChangeRecord, Outcome, RunResult};
 use crate::setup::Setup;
 
 use super::LearningLoop;
@@ -88,5 +88,21 @@ impl LearningLoop {
             }
         }
         self.finish_live(lane_change, observer)
+    }
+
+    /// The run so far as a [`RunResult`] ending in `outcome`, without a further
+    /// lane change (no frozen evaluation): what a study that stops a scene on its
+    /// own rule records, in `palc learn --record`'s format.
+    pub fn into_result(self, outcome: Outcome) -> RunResult {
+        let summary = self.run.summary(outcome, &self.policy.stopping);
+        RunResult {
+            label: self.scenario.label,
+            method: self.policy.method,
+            horizon: self.scenario.setup.horizon,
+            dt: self.scenario.setup.dt,
+            summary,
+            records: self.run.records,
+            experience: self.learner.experience,
+        }
     }
 }

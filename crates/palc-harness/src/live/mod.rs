@@ -4,7 +4,7 @@
 //! A [`LiveLaneChange`] drives one lane change step by step. Before a takeover
 //! the system drives its plan under the longitudinal guard and, with
 //! `[planning.closed_loop]` on, re-plans every period as
-//! [`crate::closed_loop::ClosedLoop::drive`] does ([`system::SystemDriver`]).
+//! [`crate::closed_loop::ClosedLoop::drive`] does (`system.rs`).
 //! At every step the live driver sees a [`LiveView`] (the state the system is
 //! about to drive, the scene, the ACC's command) and answers with a
 //! [`LiveInput`]: whether it takes over and, from then on, its controls, a
