@@ -1,12 +1,13 @@
 //! The study protocol (TOML): the participant, the scenes in order with their
 //! stopping rules, whether experience carries between scenes, the pause between
-//! them, whether the plan is shown, the tick rate and the live driver's limits.
+//! them, whether the plan is shown and the live driver's limits. The server
+//! ticks once per planning step of the learn config, in real time (10 Hz at its
+//! `dt` of 0.1 s).
 //!
 //! ```toml
 //! participant = "P01"
 //! carry_experience = true
 //! show_plan = true
-//! tick_hz = 20
 //! pause_s = 5.0
 //!
 //! [[scene]]
@@ -27,9 +28,6 @@ use crate::DriveError;
 
 /// The learn config a protocol's scenes start from unless it names its own.
 pub const DEFAULT_LEARN_CONFIG: &str = include_str!("../../../configs/learn.toml");
-
-/// Tick rates a protocol may ask for (Hz).
-pub const TICK_HZ_BOUNDS: (u32, u32) = (5, 60);
 
 /// Most scenes a protocol may hold.
 pub const MAX_SCENES: usize = 100;
@@ -54,10 +52,7 @@ pub struct Protocol {
     /// studies).
     #[serde(default = "yes")]
     pub show_plan: bool,
-    /// Server ticks per second.
-    #[serde(default = "default_tick_hz")]
-    pub tick_hz: u32,
-    /// How the server steps: in real time at `tick_hz`, or, for scripted
+    /// How the server steps: in real time, a tick per planning step, or, for scripted
     /// participants, once per control message.
     #[serde(default)]
     pub pace: Pace,
@@ -75,7 +70,7 @@ pub struct Protocol {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Pace {
-    /// A tick every `1 / tick_hz` s while the page is connected.
+    /// A tick every planning step (`planning.dt`) while the page is connected.
     #[default]
     Realtime,
     /// A tick for every control message, answered with its frame: a scripted
@@ -103,9 +98,6 @@ pub struct SceneProtocol {
 
 fn yes() -> bool {
     true
-}
-fn default_tick_hz() -> u32 {
-    20
 }
 fn default_pause_s() -> f64 {
     5.0
@@ -157,13 +149,6 @@ impl Protocol {
         if !id_ok {
             return Err(format!(
                 "`participant` is {id:?}, expected 1 to 64 letters, digits, `-` or `_`"
-            ));
-        }
-        let (low, high) = TICK_HZ_BOUNDS;
-        if !(low..=high).contains(&self.tick_hz) {
-            return Err(format!(
-                "`tick_hz` is {}, expected {low} to {high}",
-                self.tick_hz
             ));
         }
         if !(self.pause_s.is_finite() && (0.0..=600.0).contains(&self.pause_s)) {
@@ -266,7 +251,6 @@ seed = 1
     #[test]
     fn a_good_protocol_takes_the_defaults() {
         let protocol = Protocol::parse(GOOD, Path::new("study.toml")).unwrap();
-        assert_eq!(protocol.tick_hz, 20);
         assert_eq!(protocol.pace, Pace::Realtime);
         assert!(protocol.show_plan && protocol.carry_experience);
         assert_eq!(protocol.scene[0].success_streak, 3);
@@ -279,10 +263,6 @@ seed = 1
     fn every_bad_field_is_named_with_its_value_and_bound() {
         let cases = [
             (GOOD.replace("P01", "P 01"), "`participant`"),
-            (
-                format!("tick_hz = 500\n{GOOD}"),
-                "`tick_hz` is 500, expected 5 to 60",
-            ),
             (format!("pause_s = -1.0\n{GOOD}"), "`pause_s` is -1"),
             (GOOD.replace("40.0", "-4.0"), "`scene[0].headway_m` is -4"),
             (

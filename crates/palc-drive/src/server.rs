@@ -67,12 +67,12 @@ impl Drop for Connection {
 /// # Errors
 /// [`DriveError::Io`] when the server fails.
 pub async fn serve(listener: TcpListener, session: Session) -> Result<(), DriveError> {
-    let hz = session.protocol().tick_hz.max(1);
     let lockstep = session.protocol().pace == Pace::Lockstep;
+    let tick = Duration::from_secs_f64(session.dt());
     let shared = Arc::new(Shared {
         session: Mutex::new(session),
         connected: AtomicBool::new(false),
-        tick: Duration::from_secs_f64(1.0 / f64::from(hz)),
+        tick,
         lockstep,
     });
     let address = listener.local_addr().ok();

@@ -197,6 +197,11 @@ impl Session {
         &self.protocol
     }
 
+    /// The planning step (s): a tick's length in real time.
+    pub fn dt(&self) -> f64 {
+        self.base.planning.dt
+    }
+
     /// Where the session stands.
     pub fn phase(&self) -> Phase {
         self.phase

@@ -68,8 +68,12 @@ document.addEventListener("keydown", (event) => {
   }
   keys.add(event.key);
   if (event.key.startsWith("Arrow") || event.key === " ") event.preventDefault();
+  sendControls();
 });
-document.addEventListener("keyup", (event) => keys.delete(event.key));
+document.addEventListener("keyup", (event) => {
+  keys.delete(event.key);
+  sendControls();
+});
 
 const LANE = 3.5;
 function draw(now) {
@@ -87,8 +91,8 @@ function draw(now) {
   const mix = (p, q) => (previous && previous.step + 1 === latest.step ? p + (q - p) * a : q);
   const egoS = previous ? mix(previous.ego[0], latest.ego[0]) : latest.ego[0];
   const egoL = previous ? mix(previous.ego[1], latest.ego[1]) : latest.ego[1];
-  const scale = 8; // pixels per metre
-  const x = (s) => w * 0.3 + (s - egoS) * scale;
+  const scale = 5; // pixels per metre
+  const x = (s) => w * 0.15 + (s - egoS) * scale;
   const y = (l) => h / 2 + LANE * scale - l * scale;
   // The road: two lanes, edges and the marking between them.
   ctx.fillStyle = "#55595e";

@@ -126,7 +126,8 @@ impl LiveLaneChange {
 
     /// Drives the next step with the driver's `input`: the system's proposed
     /// state, or after a takeover the driver's commands held to the limits (the
-    /// acceleration also to the longitudinal guard, as a simulated user's).
+    /// acceleration also to the longitudinal guard, as a simulated user's, and
+    /// the lateral position to the road, the ego's body between its edges).
     ///
     /// # Errors
     /// [`HarnessError::LiveOutOfStep`] after the last step; scene and re-plan errors.
@@ -195,10 +196,15 @@ impl LiveLaneChange {
         self.user_speed_differs |= chosen != self.acc;
         let acceleration = guarded_user_acceleration(setup, &self.scene, previous.v, chosen);
         let moved = ballistic_step(previous.v, acceleration, setup.dt);
+        // The ego's body stays on the road: a driver steering on meets its edge.
+        let road = self.scene.road();
+        let half = self.scene.ego().map_or(0.0, |ego| ego.width / 2.0);
+        let (low, high) = (road.right_edge() + half, road.left_edge() - half);
+        let l = previous.l + self.limits.lateral_speed(input) * setup.dt;
         State {
             s: previous.s + moved.distance,
             v: moved.speed,
-            l: previous.l + self.limits.lateral_speed(input) * setup.dt,
+            l: if low <= high { l.clamp(low, high) } else { l },
             phi: 0.0,
         }
     }
