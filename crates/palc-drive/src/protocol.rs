@@ -33,7 +33,7 @@ pub const DEFAULT_LEARN_CONFIG: &str = include_str!("../../../configs/learn.toml
 pub const MAX_SCENES: usize = 100;
 
 /// Most lane changes a scene may ask for.
-pub const MAX_LANE_CHANGES: usize = 200;
+pub const MAX_LANE_CHANGES: usize = 100;
 
 /// A study protocol.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -205,8 +205,8 @@ impl Protocol {
             LearnConfig::from_toml_str(&text).map_err(|e| error(format!("`config`: {e}")))?;
         // Every scene's cell must exist in that config's test bed.
         for i in 0..self.scene.len() {
-            self.scene_config(&config, i)
-                .cell()
+            let scene = self.scene_config(&config, i);
+            (scene.validate().and_then(|()| scene.cell().map(|_| ())))
                 .map_err(|e| error(format!("`scene[{i}]`: {e}")))?;
         }
         Ok(config)
