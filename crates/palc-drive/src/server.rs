@@ -1,6 +1,8 @@
 //! The web server: the page (embedded, no build step, no CDN) at `/`, and one
 //! WebSocket at `/ws` over which the page sends its controls and the server
-//! sends a [`crate::Frame`] every tick.
+//! sends a [`crate::Frame`] every tick. The replay viewer at `/replay` reads a
+//! record chosen in the browser (a study's, `palc learn --record`'s) and shows it
+//! lane change by lane change; it sends nothing to the server.
 //!
 //! One tab drives a session: a second connection is refused (HTTP 409) while
 //! one is open. Every message is checked ([`crate::control::Inbox`]); a bad one
@@ -29,6 +31,8 @@ use crate::session::Session;
 const INDEX_HTML: &str = include_str!("page/index.html");
 const PAGE_JS: &str = include_str!("page/page.js");
 const PAGE_CSS: &str = include_str!("page/page.css");
+const REPLAY_HTML: &str = include_str!("page/replay.html");
+const REPLAY_JS: &str = include_str!("page/replay.js");
 
 /// Largest frame the WebSocket layer accepts before the checks (bytes): larger
 /// ones close the connection, which pauses the session.
@@ -83,6 +87,11 @@ pub async fn serve(listener: TcpListener, session: Session) -> Result<(), DriveE
             get(|| async { asset("text/javascript", PAGE_JS) }),
         )
         .route("/page.css", get(|| async { asset("text/css", PAGE_CSS) }))
+        .route("/replay", get(|| async { Html(REPLAY_HTML) }))
+        .route(
+            "/replay.js",
+            get(|| async { asset("text/javascript", REPLAY_JS) }),
+        )
         .route("/ws", get(upgrade))
         .with_state(shared);
     axum::serve(listener, app)

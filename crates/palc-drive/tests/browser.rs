@@ -2,8 +2,9 @@
 //! (Debian's `chromium` and `chromium-driver`; `cargo xtask test` installs them
 //! as root). The page loads, its canvas changes as the scene moves, key presses
 //! take over and steer, a lesson is learned and the next plan is closer to what
-//! was driven, and the record is on disk. A screenshot of the page is written to
-//! `target/palc-drive/browser.png`.
+//! was driven, and the record is on disk; the replay viewer reads the scene's run
+//! back. Screenshots of the page are written to `target/palc-drive/browser.png`
+//! and `replay.png`.
 //!
 //! Without Chromium or its driver the test says what is missing and skips.
 
@@ -14,7 +15,7 @@ use std::time::{Duration, Instant};
 
 use fantoccini::actions::{InputSource, KeyAction, KeyActions};
 use fantoccini::key::Key;
-use fantoccini::{Client, ClientBuilder};
+use fantoccini::{Client, ClientBuilder, Locator};
 use palc_drive::record::{Event, read_events};
 use palc_drive::{EXPERIENCE_FILE, Protocol, RECORD_FILE, Session};
 use palc_harness::RunResult;
@@ -94,8 +95,12 @@ async fn text(client: &Client, id: &str) -> String {
 }
 
 async fn canvas(client: &Client) -> String {
-    let script = "return document.getElementById('road').toDataURL();";
-    let value = client.execute(script, Vec::new()).await.unwrap();
+    canvas_of(client, "road").await
+}
+
+async fn canvas_of(client: &Client, id: &str) -> String {
+    let script = format!("return document.getElementById('{id}').toDataURL();");
+    let value = client.execute(&script, Vec::new()).await.unwrap();
     value.as_str().unwrap_or_default().to_owned()
 }
 
@@ -194,6 +199,30 @@ async fn a_participant_in_a_real_browser_takes_over_steers_and_is_learned_from()
     );
     keys(&client, press(Key::Space.into())).await;
     wait_for_text(&client, "state", "study is complete").await;
+
+    // The replay viewer reads the scene's run back, lane change by lane change.
+    client
+        .goto(&format!("http://{address}/replay"))
+        .await
+        .unwrap();
+    let blank = canvas_of(&client, "paths").await;
+    let input = client.find(Locator::Id("file")).await.unwrap();
+    let scene = std::path::absolute(out.join("scene-0.json")).unwrap();
+    input.send_keys(&scene.display().to_string()).await.unwrap();
+    wait_for_text(&client, "summary", "2 lane changes, 1 takeovers").await;
+    wait_for_text(
+        &client,
+        "lane-change",
+        "lane change 1 of 2: takeover at step",
+    )
+    .await;
+    assert_ne!(
+        canvas_of(&client, "paths").await,
+        blank,
+        "the replay drew nothing"
+    );
+    let replay = client.screenshot().await.unwrap();
+    palc_aggregator::output::write(&target.join("replay.png"), &replay).unwrap();
     client.close().await.unwrap();
 
     let events = read_events(&out.join(RECORD_FILE)).unwrap();
