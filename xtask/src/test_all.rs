@@ -1,6 +1,7 @@
 //! `cargo xtask test`: every test of the project, Rust and Python.
 //!
-//! First `cargo test --workspace`; then the Python checks of the CommonRoad
+//! First Chromium and its WebDriver for the real-browser test (installed as
+//! root when missing), then `cargo test --workspace`; then the Python checks of the CommonRoad
 //! export: a virtual environment in `target/venv` (created once, its packages
 //! installed again only when `python/requirements-test.txt` changes), a release
 //! build of `palc`, `palc export commonroad` for the default scene and the grid
@@ -37,6 +38,7 @@ pub fn run(args: impl Iterator<Item = String>) -> anyhow::Result<()> {
         std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| PathBuf::from("target"), PathBuf::from);
 
     if !python_only {
+        browser()?;
         heading("cargo test --workspace (the Rust tests)");
         status(
             Command::new(&cargo).args(["test", "--workspace"]),
@@ -216,6 +218,34 @@ fn create_venv(dir: &Path) -> anyhow::Result<()> {
     anyhow::bail!(
         "`python3 -m venv {}` failed: install Python's venv module (e.g. `apt-get install python3-venv`)",
         dir.display()
+    )
+}
+
+/// The real-browser test's Chromium and WebDriver (Debian's `chromium`, `chromium-driver`):
+/// installed with apt-get as root when missing, else a notice that the test will skip.
+fn browser() -> anyhow::Result<()> {
+    let found = |bin: &str| {
+        Command::new(bin)
+            .arg("--version")
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if found("chromium") && found("chromedriver") {
+        return Ok(());
+    }
+    if !is_root() {
+        println!(
+            "NOTICE: chromium or chromedriver is missing and this is not root: the real-browser test \
+                  (crates/palc-drive/tests/browser.rs) will be SKIPPED; install `chromium chromium-driver`"
+        );
+        return Ok(());
+    }
+    heading("apt-get install chromium chromium-driver (the real-browser test)");
+    status(Command::new("apt-get").arg("update"), "apt-get update")?;
+    let install = ["install", "-y", "chromium", "chromium-driver"];
+    status(
+        Command::new("apt-get").args(install),
+        "apt-get install -y chromium chromium-driver",
     )
 }
 

@@ -139,8 +139,9 @@ fn no_stubs_are_left_in_the_code() {
 
 /// xtask only orchestrates; the evaluation lives in `crates/palc-eval`.
 /// The budget counts the tasks: these hygiene tests (`tidy.rs`, built only for
-/// tests) are not part of what `cargo xtask` runs.
-const XTASK_LINE_BUDGET: usize = 400;
+/// tests) are not part of what `cargo xtask` runs. The real-browser test's
+/// Chromium install raised it from 400.
+const XTASK_LINE_BUDGET: usize = 430;
 
 #[test]
 fn xtask_stays_within_its_line_budget() {
@@ -207,6 +208,16 @@ const DEPENDENCY_RULES: &[(&str, &[&str], bool)] = &[
             "palc-planner",
             "palc-aggregator",
             "palc-user",
+        ],
+        true,
+    ),
+    (
+        "palc-drive",
+        &[
+            "palc-traffic",
+            "palc-planner",
+            "palc-aggregator",
+            "palc-harness",
         ],
         true,
     ),

@@ -20,6 +20,10 @@
 //! through `rustix`), so the destination holds either all of the previous files or
 //! all of the new ones.
 //!
+//! [`AppendLog`] is the one exception to whole-file writes: a log that only grows
+//! (a driving study's record), opened for appending, flushed and synced to disk
+//! at the points the caller chooses, never truncated or rewritten.
+//!
 //! The temporary file itself comes from `tempfile` (unique name, removed on every
 //! error path); this module only adds what `tempfile` leaves to the caller.
 
@@ -641,5 +645,59 @@ mod tests {
             None
         );
         assert_eq!(temporary_owner(OsStr::new("e.json"), &prefix), None);
+    }
+}
+
+/// A file that only grows by appended bytes, synced to disk when asked.
+#[derive(Debug)]
+pub struct AppendLog {
+    path: PathBuf,
+    file: BufWriter<fs::File>,
+}
+
+impl AppendLog {
+    /// Opens `path` for appending: a new file when `create` (an existing one is
+    /// an error, so no log is appended to by mistake), else an existing one.
+    ///
+    /// # Errors
+    /// [`OutputError`] naming `path`.
+    pub fn open(path: &Path, create: bool) -> Result<Self, OutputError> {
+        let mut options = fs::OpenOptions::new();
+        options.append(true);
+        if create {
+            options.create_new(true);
+        }
+        let file = options.open(path).map_err(|error| OutputError {
+            path: path.to_path_buf(),
+            error,
+        })?;
+        Ok(Self {
+            path: path.to_path_buf(),
+            file: BufWriter::new(file),
+        })
+    }
+
+    /// Appends `bytes` (buffered).
+    ///
+    /// # Errors
+    /// [`OutputError`] naming the file.
+    pub fn append(&mut self, bytes: &[u8]) -> Result<(), OutputError> {
+        self.file.write_all(bytes).map_err(|error| OutputError {
+            path: self.path.clone(),
+            error,
+        })
+    }
+
+    /// Flushes the buffer, checks the flush and syncs the file's data to disk.
+    ///
+    /// # Errors
+    /// [`OutputError`] naming the file.
+    pub fn sync(&mut self) -> Result<(), OutputError> {
+        let error = |error| OutputError {
+            path: self.path.clone(),
+            error,
+        };
+        self.file.flush().map_err(error)?;
+        self.file.get_ref().sync_data().map_err(error)
     }
 }

@@ -29,6 +29,8 @@ enum Command {
     /// Run an evaluation config: the paper's reproduction by default (runs, statistics,
     /// REPORT.md, figures).
     Eval(commands::eval::EvalArgs),
+    /// A browser driving study: a person drives, palc learns from their takeovers.
+    Drive(commands::drive::DriveArgs),
     /// Learn a user's lane changes from takeovers (the lesson-learning loop).
     Learn(commands::learn::LearnArgs),
     /// Background traffic on its own (IDM scenes, platoons).
@@ -50,6 +52,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Eval(args) => commands::eval::run(args),
+        Command::Drive(args) => commands::drive::run(args),
         Command::Learn(args) => commands::learn::run_learn(args),
         Command::Traffic(args) => commands::traffic::run(args),
         Command::Plan(args) => commands::plan::run(args),

@@ -109,6 +109,16 @@ impl ClosedLoop {
         })
     }
 
+    /// Steps between re-plans.
+    pub fn period(&self) -> usize {
+        self.period
+    }
+
+    /// Whether the safety layer's fallback (the standard ALC's weights) is set.
+    pub fn has_fallback(&self) -> bool {
+        self.standard.is_some()
+    }
+
     /// Re-plans with `reference_speed` (one per step of the scenario's horizon) and
     /// `terminal` instead of the scenario's speeds: those the learning loop's plans
     /// follow once they have learned the user's

@@ -465,7 +465,7 @@ pub(crate) fn states_safety(
 
 /// The first step from which the driven lateral position stays within 5 cm of the
 /// target lane's centre: the end of the lane change.
-fn lane_change_end(driven: &[State], target_l: f64) -> usize {
+pub(crate) fn lane_change_end(driven: &[State], target_l: f64) -> usize {
     let mut end = driven.len() - 1;
     for i in (0..driven.len()).rev() {
         if (driven[i].l - target_l).abs() > 0.05 {

@@ -121,6 +121,16 @@ pub enum HarnessError {
     /// An error of the aggregator.
     #[error(transparent)]
     Aggregator(#[from] palc_aggregator::AggregatorError),
+    /// A live lane change was finished before its last step, or stepped after it.
+    #[error("live lane change: {steps} of {expected} steps driven when it was {action}")]
+    LiveOutOfStep {
+        /// Steps driven.
+        steps: usize,
+        /// Steps of the lane change (`K + 1`).
+        expected: usize,
+        /// What was asked (`finished`, `stepped`).
+        action: &'static str,
+    },
 }
 
 impl HarnessError {

@@ -43,6 +43,7 @@ mod error;
 mod guard;
 mod learning_loop;
 mod lesson;
+pub mod live;
 mod method;
 mod observer;
 mod onset;

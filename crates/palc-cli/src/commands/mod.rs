@@ -1,5 +1,6 @@
 //! One module per `palc` subcommand.
 
+pub mod drive;
 pub mod eval;
 pub mod export;
 pub mod import;

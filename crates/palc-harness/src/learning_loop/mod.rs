@@ -13,6 +13,7 @@
 //! [`Policy`].
 
 mod checks;
+mod live;
 mod run_state;
 
 use std::time::Instant;
@@ -266,12 +267,24 @@ impl LearningLoop {
     pub fn step(&mut self, observer: &mut dyn Observer) -> Result<&LaneChangeRecord, HarnessError> {
         let index = self.run.records.len();
         let (drive, record) = self.drive_next_plan(index, observer)?;
+        self.conclude(index, &drive, record, observer)
+    }
+
+    /// Records lane change `index` (driven as `drive`) and, on a takeover within
+    /// the cap, learns from it: the second half of [`LearningLoop::step`].
+    fn conclude(
+        &mut self,
+        index: usize,
+        drive: &Drive,
+        record: LaneChangeRecord,
+        observer: &mut dyn Observer,
+    ) -> Result<&LaneChangeRecord, HarnessError> {
         observer.lane_change(&record);
         self.run.count(record);
         self.learner.pending_times = Timings::default();
         match drive.takeover {
             Some(takeover) if self.run.takeovers < self.policy.stopping.max_takeovers => {
-                self.learn(index, &drive, takeover.step, observer)?;
+                self.learn(index, drive, takeover.step, observer)?;
             }
             Some(_) => {}
             None => {
