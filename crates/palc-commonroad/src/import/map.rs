@@ -10,6 +10,7 @@
 use std::collections::HashMap;
 
 use super::error::ImportError;
+use super::params::MAX_COORDINATE_M;
 use super::geometry::{Point, Polyline, contains, resample};
 use super::record::Direction;
 use super::xml::XmlLanelet;
@@ -62,8 +63,12 @@ impl Map {
             if left.len() < 2 || right.len() < 2 {
                 return Err(invalid(l.id, "a bound has fewer than two points"));
             }
-            if left.iter().chain(&right).flatten().any(|v| !v.is_finite()) {
-                return Err(invalid(l.id, "a bound has a non-finite coordinate"));
+            let in_range = |c: &f64| c.is_finite() && c.abs() <= MAX_COORDINATE_M;
+            if !left.iter().chain(&right).flatten().all(in_range) {
+                return Err(invalid(
+                    l.id,
+                    "a bound has a coordinate that is not finite or beyond ±1e9 m",
+                ));
             }
             let n = left.len().max(right.len());
             let (left, right) = if left.len() == right.len() {

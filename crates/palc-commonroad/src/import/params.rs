@@ -54,3 +54,9 @@ pub const HEADWAY_MIN_SPEED_MPS: f64 = 0.5;
 /// Consecutive centre points closer than this (m) are merged when lanelets are joined into
 /// a corridor: a zero-length segment has no direction and no lateral offset.
 pub const POINT_MERGE_M: f64 = 1e-3;
+
+/// The largest coordinate (m) of a lanelet vertex or a vehicle position: far
+/// beyond any map (the Earth's circumference is 4·10⁷ m), small enough that
+/// the squares and differences of the import stay finite (a coordinate of 1e308
+/// is finite, but the lateral offset computed from it is not).
+pub(crate) const MAX_COORDINATE_M: f64 = 1e9;

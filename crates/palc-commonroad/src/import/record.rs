@@ -173,7 +173,8 @@ pub enum SkipReason {
     /// Its time steps do not increase by one from sample to sample (the track is not
     /// split: a lane change across a gap cannot be measured).
     TimeGap,
-    /// A position, speed, size or orientation is NaN or infinite.
+    /// A position, speed, size or orientation is NaN or infinite, or a position
+    /// lies beyond ±1e9 m.
     NonFinite,
     /// It has no rectangle shape, no position point or no integer time step.
     Incomplete,

@@ -2,6 +2,7 @@
 //! the reason the vehicle is skipped.
 
 use super::geometry::Point;
+use super::params::MAX_COORDINATE_M;
 use super::record::SkipReason;
 use super::xml::{XmlObstacle, XmlState};
 
@@ -84,8 +85,9 @@ pub(crate) fn track(obstacle: &XmlObstacle, dt: f64) -> Result<Track, (SkipReaso
         let exact = |v: &Option<super::xml::XmlExact>| v.as_ref().and_then(|v| v.exact);
         let v = exact(&state.velocity);
         let others = [exact(&state.orientation), exact(&state.acceleration), v];
-        if !point.x.is_finite()
-            || !point.y.is_finite()
+        let in_range = |c: f64| c.is_finite() && c.abs() <= MAX_COORDINATE_M;
+        if !in_range(point.x)
+            || !in_range(point.y)
             || others.iter().flatten().any(|v| !v.is_finite())
         {
             return Err((SkipReason::NonFinite, Some(step)));
