@@ -10,8 +10,8 @@
 use std::collections::HashMap;
 
 use super::error::ImportError;
-use super::params::MAX_COORDINATE_M;
 use super::geometry::{Point, Polyline, contains, resample};
+use super::params::MAX_COORDINATE_M;
 use super::record::Direction;
 use super::xml::XmlLanelet;
 
