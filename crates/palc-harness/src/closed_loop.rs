@@ -34,7 +34,9 @@
 //! exactly as in open loop, so that lessons are labelled the same way.
 
 use palc_aggregator::{AggregatorOptions, Experience, plan_problem};
-use palc_planner::{Plan, Planner, PlannerConfig, Position, State, Terminal, Weights, features};
+use palc_planner::{
+    Control, Plan, Planner, PlannerConfig, Position, State, Terminal, Weights, features,
+};
 use palc_traffic::Scene;
 use palc_zone_filter::StepScene;
 
@@ -291,19 +293,12 @@ impl ClosedLoop {
                 Replan::Refused(_) => {}
             }
         }
-        let full = problem(setup, experience.weights.clone(), Vec::new());
-        let features = features(&states, &controls, &full.preceding, &full.adjacent)?;
-        let learned_cost = experience.weights.dot(&features).unwrap_or(f64::NAN);
-        let plan = Plan {
-            states,
-            controls,
-            objective: learned_cost,
-            learned_cost,
-            extras: palc_planner::Extras::default(),
-            features,
-            lateral_violation,
-            stats: first.stats,
-        };
+        let plan = driven_plan(
+            setup,
+            experience,
+            (states, controls, lateral_violation),
+            first,
+        )?;
         Ok((plan, stats))
     }
 
@@ -453,4 +448,28 @@ fn safety_from(
         false
     })?;
     Ok(monitor.metrics())
+}
+
+/// The trajectory a lane change drove, pieced from its re-plans, as one plan:
+/// its features and learned cost under `experience`'s weights (the objective is
+/// the learned cost), the first plan's solver statistics.
+pub(crate) fn driven_plan(
+    setup: &Setup,
+    experience: &Experience,
+    (states, controls, lateral_violation): (Vec<State>, Vec<Control>, Vec<f64>),
+    first: &Plan,
+) -> Result<Plan, HarnessError> {
+    let full = problem(setup, experience.weights.clone(), Vec::new());
+    let features = features(&states, &controls, &full.preceding, &full.adjacent)?;
+    let learned_cost = experience.weights.dot(&features).unwrap_or(f64::NAN);
+    Ok(Plan {
+        states,
+        controls,
+        objective: learned_cost,
+        learned_cost,
+        extras: palc_planner::Extras::default(),
+        features,
+        lateral_violation,
+        stats: first.stats,
+    })
 }

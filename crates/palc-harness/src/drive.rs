@@ -227,23 +227,8 @@ pub fn execute_in(
         deviation_m: (planned_l[step] - expected_l[step]).abs(),
         cause,
     });
-    let perceived_safety_ratio = match &takeover {
-        None => 1.0,
-        Some(t) => {
-            // The lane change ends where the driven path settles on the target lane,
-            // and never before the step after the takeover, so that a takeover
-            // always gives a ratio below 1.
-            let end = lane_change_end(&driven, setup.target_l)
-                .max(t.step + 1)
-                .min(k);
-            let whole = driven[end].s;
-            if whole > 0.0 {
-                (t.distance_m / whole).clamp(0.0, 1.0)
-            } else {
-                0.0
-            }
-        }
-    };
+    let perceived_safety_ratio =
+        perceived_safety_ratio(&driven, setup.target_l, k, takeover.as_ref());
     Ok(Drive {
         max_deviation_m: max_deviation(&planned_l, &expected_l),
         plan,
@@ -461,6 +446,28 @@ pub(crate) fn states_safety(
         false
     })?;
     Ok(monitor.metrics())
+}
+
+/// The share of the driven lane change's distance covered before the takeover
+/// (1 without one). The lane change ends where the driven path settles on the
+/// target lane, and never before the step after the takeover, so that a
+/// takeover always gives a ratio below 1.
+pub(crate) fn perceived_safety_ratio(
+    driven: &[State],
+    target_l: f64,
+    k: usize,
+    takeover: Option<&Takeover>,
+) -> f64 {
+    let Some(t) = takeover else {
+        return 1.0;
+    };
+    let end = lane_change_end(driven, target_l).max(t.step + 1).min(k);
+    let whole = driven[end].s;
+    if whole > 0.0 {
+        (t.distance_m / whole).clamp(0.0, 1.0)
+    } else {
+        0.0
+    }
 }
 
 /// The first step from which the driven lateral position stays within 5 cm of the

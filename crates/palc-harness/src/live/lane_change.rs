@@ -9,7 +9,7 @@ use super::input::{LiveInput, LiveLimits, LiveView};
 use super::system::SystemDriver;
 use crate::HarnessError;
 use crate::acc::acc_leader;
-use crate::drive::{Drive, lane_change_end};
+use crate::drive::{Drive, perceived_safety_ratio};
 use crate::guard::guarded_user_acceleration;
 use crate::record::{ClosedLoopStats, Takeover};
 use crate::safety::{SafetyMetrics, SafetyMonitor, Violation};
@@ -246,20 +246,8 @@ impl LiveLaneChange {
             deviation_m: deviation(step),
             cause: TakeoverCause::Deviation,
         });
-        let perceived_safety_ratio = match &takeover {
-            None => 1.0,
-            Some(t) => {
-                let end = lane_change_end(&driven, setup.target_l)
-                    .max(t.step + 1)
-                    .min(k);
-                let whole = driven[end].s;
-                if whole > 0.0 {
-                    (t.distance_m / whole).clamp(0.0, 1.0)
-                } else {
-                    0.0
-                }
-            }
-        };
+        let perceived_safety_ratio =
+            perceived_safety_ratio(&driven, setup.target_l, k, takeover.as_ref());
         let max_deviation_m = (0..=k).map(deviation).fold(0.0, f64::max);
         let drive = Drive {
             plan,

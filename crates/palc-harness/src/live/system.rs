@@ -4,12 +4,11 @@
 //! simulated user would.
 
 use palc_aggregator::{AggregatorOptions, Experience};
-use palc_planner::{Control, Plan, State, features};
+use palc_planner::{Control, Plan, State};
 use palc_traffic::Scene;
 
 use crate::HarnessError;
-use crate::closed_loop::{ClosedLoop, Policy, Replan};
-use crate::drive::problem;
+use crate::closed_loop::{ClosedLoop, Policy, Replan, driven_plan};
 use crate::guard::guarded_step;
 use crate::record::ClosedLoopStats;
 use crate::setup::Setup;
@@ -163,19 +162,8 @@ impl SystemDriver {
         controls.extend_from_slice(&self.current.controls[j..]);
         let mut lateral_violation = self.lateral_violation.clone();
         lateral_violation.resize(states.len(), 0.0);
-        let full = problem(setup, experience.weights.clone(), Vec::new());
-        let features = features(&states, &controls, &full.preceding, &full.adjacent)?;
-        let learned_cost = experience.weights.dot(&features).unwrap_or(f64::NAN);
-        let plan = Plan {
-            states,
-            controls,
-            objective: learned_cost,
-            learned_cost,
-            extras: palc_planner::Extras::default(),
-            features,
-            lateral_violation,
-            stats: self.first.stats,
-        };
+        let pieces = (states, controls, lateral_violation);
+        let plan = driven_plan(setup, experience, pieces, &self.first)?;
         Ok((plan, Some(self.stats)))
     }
 }
