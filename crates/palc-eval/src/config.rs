@@ -20,6 +20,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::EvalError;
 use crate::ablation::AblationConfig;
+use crate::drive::{DriveConfig, DriveScene};
 
 /// The parsed evaluation config.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -43,6 +44,9 @@ pub struct EvalConfig {
     /// The ablation ladder from `paper` to `palc`; none if absent.
     #[serde(default)]
     pub ablation: AblationConfig,
+    /// A drive of varied scenes; none if absent.
+    #[serde(default, skip_serializing_if = "DriveConfig::is_empty")]
+    pub drive: DriveConfig,
     /// The `--quick` subset.
     pub quick: QuickConfig,
     /// The most runs the evaluation may expand to, checked before any run
@@ -252,6 +256,9 @@ pub struct QuickConfig {
     /// The quick closed-loop experiment (on the quick grid); none if absent.
     #[serde(default)]
     pub closed_loop: ClosedLoopRuns,
+    /// The quick drive (around the quick grid); none if absent.
+    #[serde(default, skip_serializing_if = "DriveConfig::is_empty")]
+    pub drive: DriveConfig,
 }
 
 /// What one invocation runs: the full evaluation or the quick subset.
@@ -274,6 +281,17 @@ pub struct Selection {
     /// The accepted drivers of each recorded user kind, by kind name: each runs
     /// in place of the grid's styles. Filled when the recorded files are read.
     pub drivers: std::collections::BTreeMap<String, Vec<String>>,
+    /// The drive of varied scenes: its users and its scenes, in driving order.
+    pub drive: Drive,
+}
+
+/// The drive of a selection ([`crate::drive`]).
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Drive {
+    /// Names of the user kinds that drive.
+    pub users: Vec<String>,
+    /// The scenes, in driving order.
+    pub scenes: Vec<DriveScene>,
 }
 
 /// Parses TOML text; an error names the dotted path of the field it is in (e.g.
@@ -303,8 +321,13 @@ impl EvalConfig {
     /// lists completed from the base config's test bed.
     pub fn select(&self, quick: bool, testbed: &TestbedConfig) -> Result<Selection, EvalError> {
         if !quick {
+            let grid = self.grid.resolve("grid", testbed)?;
+            let drive = Drive {
+                users: self.drive.users.clone(),
+                scenes: self.drive.scenes("drive", &grid)?,
+            };
             return Ok(Selection {
-                grid: self.grid.resolve("grid", testbed)?,
+                grid,
                 users: self.users.clone(),
                 transfer: self.transfer.clone(),
                 closed_loop: self.closed_loop.clone(),
@@ -312,6 +335,7 @@ impl EvalConfig {
                 example: self.example.clone(),
                 ablation: self.ablation.clone(),
                 drivers: Default::default(),
+                drive,
             });
         }
         let users = (self.quick.users.iter())
@@ -329,8 +353,13 @@ impl EvalConfig {
             accumulation_users: quick(&self.transfer.accumulation_users),
             ..self.transfer.clone()
         };
+        let grid = self.quick.grid.resolve("quick.grid", testbed)?;
+        let drive = Drive {
+            users: self.quick.drive.users.clone(),
+            scenes: self.quick.drive.scenes("quick.drive", &grid)?,
+        };
         Ok(Selection {
-            grid: self.quick.grid.resolve("quick.grid", testbed)?,
+            grid,
             users,
             transfer,
             closed_loop: self.quick.closed_loop.clone(),
@@ -341,6 +370,7 @@ impl EvalConfig {
                 ..self.ablation.clone()
             },
             drivers: Default::default(),
+            drive,
         })
     }
 
@@ -461,6 +491,20 @@ impl EvalConfig {
                 "empty",
                 "at least one user kind",
             ));
+        }
+        self.drive.validate("drive")?;
+        self.quick.drive.validate("quick.drive")?;
+        for name in &self.drive.users {
+            self.user(name, "drive.users")?;
+        }
+        for name in &self.quick.drive.users {
+            if !self.quick.users.contains(name) {
+                return Err(EvalError::invalid(
+                    "quick.drive.users",
+                    format_args!("`{name}`"),
+                    "a user kind of quick.users",
+                ));
+            }
         }
         self.ablation.resolve()?;
         self.timing.validate("timing")?;
@@ -617,6 +661,37 @@ mod tests {
         assert!(config.timing.dts.contains(&0.05));
         let quick = config.select(true, &testbed()).unwrap();
         assert!(quick.grid.cells() < full.grid.cells());
+    }
+
+    #[test]
+    fn drive_users_are_known_and_the_quick_ones_run_in_the_quick_subset() {
+        let config = project_config();
+        let full = config.select(false, &testbed()).unwrap();
+        assert_eq!(full.drive.scenes.len(), config.drive.lane_changes());
+        assert_eq!(full.drive.users, config.drive.users);
+        let quick = config.select(true, &testbed()).unwrap();
+        assert!(
+            quick
+                .drive
+                .users
+                .iter()
+                .all(|u| config.quick.users.contains(u))
+        );
+        let mut bad = project_config();
+        bad.drive.users = vec!["nobody".into()];
+        let error = bad.validate().unwrap_err().to_string();
+        assert!(
+            error.contains("drive.users") && error.contains("nobody"),
+            "{error}"
+        );
+        let mut bad = project_config();
+        bad.quick.drive.users = vec!["spread-5%".into()];
+        let error = bad.validate().unwrap_err().to_string();
+        assert!(error.contains("quick.drive.users"), "{error}");
+        let mut bad = project_config();
+        bad.quick.drive.lane_changes = Some(0);
+        let error = bad.validate().unwrap_err().to_string();
+        assert!(error.contains("quick.drive.lane_changes"), "{error}");
     }
 
     #[test]

@@ -216,6 +216,25 @@ pub fn draw_all(
             )?;
         }
     }
+    for &method in methods {
+        let drive = crate::drive_report::figures(rows, method, 6);
+        let count = drive.len();
+        for (i, figure) in drive.iter().enumerate() {
+            let name = method.name();
+            let part = if count > 1 {
+                format!("-{}", i + 1)
+            } else {
+                String::new()
+            };
+            save(
+                format!("fig16-drive-{name}{part}"),
+                format!(
+                    "Fig. 16 (not in the paper): `{name}`, takeover rate over the last 10 lane changes of a drive of varied scenes, every style of each user kind together (REPORT.md, \"A drive of varied scenes\")"
+                ),
+                &|dir, stem| figures::save(dir, stem, (900, 450), figure).map(|_| ()),
+            )?;
+        }
+    }
     let gaps = Lines {
         title: "Smallest net gap per lane change, system-driven steps (grid)".into(),
         x_desc: "smallest net gap to the preceding, lead or lag vehicle (m; < 0: overlap)".into(),

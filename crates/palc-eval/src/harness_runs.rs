@@ -10,8 +10,8 @@ use std::time::Instant;
 use palc_aggregator::Experience;
 use palc_harness::user::{Spread, TakeoverCause};
 use palc_harness::{
-    CellChoice, HarnessError, LaneChangeRecord, LearnConfig, LessonEvent, Observer, Outcome,
-    RunResult, UserConfig,
+    CellChoice, HarnessError, LaneChangeRecord, LearnConfig, LearningLoop, LessonEvent, Observer,
+    Outcome, RunResult, UserConfig,
 };
 use palc_traffic::TestbedConfig;
 use serde::Serialize;
@@ -138,6 +138,17 @@ impl HarnessRuns {
         if spec.experiment == Experiment::ClosedLoop {
             config.planning.closed_loop.enabled = true;
         }
+        if spec.experiment == Experiment::Drive {
+            // A drive's scene is driven once: no evaluation phase after it, and
+            // a drawn speed case joins the test bed's.
+            config.stopping.frozen_lane_changes = 0;
+            if let Some(testbed) = config.traffic.testbed.as_mut() {
+                let case = &spec.speed_case;
+                if !testbed.speed_cases.iter().any(|c| c.name == case.name) {
+                    testbed.speed_cases.push(case.clone());
+                }
+            }
+        }
         if let Some(name) = &spec.rung {
             let rung = (self.rungs.iter().find(|r| &r.name == name)).ok_or_else(|| {
                 EvalError::Unknown {
@@ -175,7 +186,7 @@ impl Executor for HarnessRuns {
 
     fn run(&self, spec: &RunSpec, experience: Option<&Experience>) -> (RunRow, Option<Experience>) {
         let start = Instant::now();
-        let cap = self.cap();
+        let cap = cap_of(spec, self.cap());
         let config = match self.config(spec) {
             Ok(config) => config,
             Err(error) => {
@@ -186,7 +197,10 @@ impl Executor for HarnessRuns {
             }
         };
         let mut recorder = RowRecorder::default();
-        let result = palc_harness::run(&config, experience, &mut recorder);
+        let result = match spec.experiment {
+            Experiment::Drive => one_lane_change(&config, experience, &mut recorder),
+            _ => palc_harness::run(&config, experience, &mut recorder),
+        };
         let wall_s = start.elapsed().as_secs_f64();
         match result {
             Ok(result) => {
@@ -217,6 +231,33 @@ impl Executor for HarnessRuns {
     }
 }
 
+/// The takeovers a run counts at most: a drive's lane change is one lane change,
+/// which counts one takeover when taken over or when it failed; other runs count
+/// the loop's cap.
+fn cap_of(spec: &RunSpec, cap: usize) -> usize {
+    match spec.experiment {
+        Experiment::Drive => 1,
+        _ => cap,
+    }
+}
+
+/// One lane change of a drive ([`crate::drive`]): the scene's plan is driven
+/// once and its takeover, if any, learned; the run then ends, `personalized` when
+/// the lane change was not taken over and `cap-reached` when it was.
+fn one_lane_change(
+    config: &LearnConfig,
+    experience: Option<&Experience>,
+    observer: &mut dyn Observer,
+) -> Result<RunResult, HarnessError> {
+    let mut run = LearningLoop::new(config, experience)?;
+    let taken_over = run.step(observer)?.takeover.is_some();
+    let outcome = match taken_over {
+        true => Outcome::CapReached,
+        false => Outcome::Personalized,
+    };
+    run.finish(outcome, observer)
+}
+
 fn row(spec: &RunSpec, result: &RunResult, iterations: Vec<Iteration>, wall_s: f64) -> RunRow {
     let summary = &result.summary;
     RunRow {
@@ -225,8 +266,9 @@ fn row(spec: &RunSpec, result: &RunResult, iterations: Vec<Iteration>, wall_s: f
             Outcome::Personalized => Status::Personalized,
             Outcome::CapReached => Status::CapReached,
         },
-        takeovers: summary.counted_takeovers(),
-        cap: summary.cap,
+        takeovers: (summary.outcome)
+            .counted_takeovers(summary.takeovers, cap_of(spec, summary.cap)),
+        cap: cap_of(spec, summary.cap),
         lane_changes: summary.lane_changes,
         final_max_deviation_m: Some(summary.final_max_deviation_m),
         final_takeover_rate: Some(summary.final_takeover_rate),

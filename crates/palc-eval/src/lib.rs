@@ -35,6 +35,8 @@ pub mod ablation_report;
 pub mod claims;
 pub mod closed_loop_report;
 pub mod config;
+pub mod drive;
+pub mod drive_report;
 mod error;
 #[cfg(feature = "plot")]
 mod experiments;

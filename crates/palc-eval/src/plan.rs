@@ -33,6 +33,9 @@ pub enum Experiment {
     /// An ablation cell started with the experience of the same rung in the
     /// cell's other scene (`transfer.source`).
     AblationTransfer,
+    /// One lane change of a drive of varied scenes (`[drive]`, [`crate::drive`]),
+    /// started with the experience of the drive's lane change before it.
+    Drive,
 }
 
 impl Experiment {
@@ -47,6 +50,7 @@ impl Experiment {
             Experiment::Accumulation => "accumulation",
             Experiment::Ablation => "ablation",
             Experiment::AblationTransfer => "ablation-transfer",
+            Experiment::Drive => "drive",
         }
     }
 }
@@ -143,7 +147,8 @@ pub struct RunPlan {
     /// Grid and timing runs.
     pub first: Vec<RunSpec>,
     /// Runs with experience; `experience_from` points into `first` or to an
-    /// earlier run of this list (accumulation).
+    /// earlier run of this list (accumulation, drive). A drive's first lane
+    /// change has none: it starts from scratch.
     pub transfer: Vec<RunSpec>,
 }
 
@@ -376,6 +381,7 @@ pub fn expand_bounded(
             }
         }
     }
+    drives(selection, &mut transfer, first.len(), max_runs)?;
     Ok(RunPlan { first, transfer })
 }
 
@@ -393,20 +399,7 @@ fn grid_cells(
     rung: Option<String>,
     max_runs: usize,
 ) -> Result<(), EvalError> {
-    let users: Vec<(StylePreset, UserKind)> = match &user.recorded {
-        Some(_) => (drivers.iter())
-            .map(|driver| {
-                let user = UserKind {
-                    driver: Some(driver.clone()),
-                    ..user.clone()
-                };
-                (grid.styles[0], user)
-            })
-            .collect(),
-        None => (grid.styles.iter())
-            .map(|&style| (style, user.clone()))
-            .collect(),
-    };
+    let users = styled(grid, user, drivers);
     for case in &grid.speed_cases {
         for &headway_m in &grid.headways_m {
             for (style, user) in &users {
@@ -426,6 +419,68 @@ fn grid_cells(
                         experience_from: None,
                         rung: rung.clone(),
                     });
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The users of `user`'s runs: one per style of the grid, or, for a recorded
+/// kind, one per driver (each with its own style; the preset is the grid's
+/// first, unused).
+fn styled(grid: &Grid, user: &UserKind, drivers: &[String]) -> Vec<(StylePreset, UserKind)> {
+    match &user.recorded {
+        Some(_) => (drivers.iter())
+            .map(|driver| {
+                let user = UserKind {
+                    driver: Some(driver.clone()),
+                    ..user.clone()
+                };
+                (grid.styles[0], user)
+            })
+            .collect(),
+        None => (grid.styles.iter())
+            .map(|&style| (style, user.clone()))
+            .collect(),
+    }
+}
+
+/// Appends the drives of `selection` to `transfer` (whose first id is
+/// `offset`): per method, drive user and style (or recorded driver), one chain
+/// of runs through the drive's scenes, each but the first starting from the one
+/// before it.
+fn drives(
+    selection: &Selection,
+    transfer: &mut Vec<RunSpec>,
+    offset: usize,
+    max_runs: usize,
+) -> Result<(), EvalError> {
+    let grid = &selection.grid;
+    let drive = &selection.drive;
+    for method in &grid.methods {
+        for user in (selection.users.iter()).filter(|u| drive.users.contains(&u.name)) {
+            let drivers = (selection.drivers.get(&user.name)).map_or(&[][..], Vec::as_slice);
+            for (style, user) in styled(grid, user, drivers) {
+                let mut previous = None;
+                for scene in &drive.scenes {
+                    let id = offset + transfer.len();
+                    room(id, max_runs)?;
+                    transfer.push(RunSpec {
+                        id,
+                        experiment: Experiment::Drive,
+                        method: *method,
+                        user: user.clone(),
+                        style,
+                        speed_case: scene.speed_case.clone(),
+                        headway_m: scene.headway_m,
+                        seed: scene.seed,
+                        dt: None,
+                        horizon_margin_s: None,
+                        experience_from: previous,
+                        rung: None,
+                    });
+                    previous = Some(id);
                 }
             }
         }
@@ -546,6 +601,7 @@ pub(crate) mod tests {
             },
             ablation: crate::ablation::AblationConfig::default(),
             drivers: Default::default(),
+            drive: Default::default(),
         }
     }
 

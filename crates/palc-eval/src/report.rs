@@ -73,6 +73,7 @@ pub fn render(input: &ReportInput) -> String {
     crate::families_report::section(&mut out, input.rows, input.methods, input.user_kinds);
     crate::recorded_report::section(&mut out, input.recorded, input.rows);
     crate::transfer_report::section(&mut out, input.rows, input.methods);
+    crate::drive_report::section(&mut out, input.rows, input.methods);
     crate::ablation_report::section(&mut out, input.rows, input.ablation.0, input.ablation.1);
     claims_section(&mut out);
     crate::safety_report::section(&mut out, input.rows, input.methods);

@@ -10,14 +10,14 @@ use std::collections::HashMap;
 use rayon::prelude::*;
 
 use crate::EvalError;
-use crate::plan::{RunPlan, RunSpec};
+use crate::plan::{Experiment, RunPlan, RunSpec};
 use crate::results::{RunRow, Status};
 
 /// Runs one spec. The harness implements it (`harness_runs.rs`); tests use
 /// synthetic executors.
 pub trait Executor: Sync {
     /// What a run learned, to start another run from.
-    type Experience: Send + Sync;
+    type Experience: Send + Sync + Clone;
 
     /// Runs `spec`, from `experience` if given; returns the row and, when the
     /// run produced one, its experience.
@@ -84,11 +84,12 @@ pub fn execute<E: Executor>(
         .num_threads(check_jobs(jobs)?)
         .build()?;
     progress.started(plan.len());
-    let sources: Vec<usize> = plan
-        .transfer
-        .iter()
-        .filter_map(|s| s.experience_from)
-        .collect();
+    // How many runs start from each run's experience: an experience is kept
+    // until the last of them has started, then dropped.
+    let mut uses: HashMap<usize, usize> = HashMap::new();
+    for source in plan.transfer.iter().filter_map(|s| s.experience_from) {
+        *uses.entry(source).or_default() += 1;
+    }
     let (mut rows, experiences): (Vec<RunRow>, HashMap<usize, E::Experience>) =
         pool.install(|| {
             let done: Vec<(RunRow, Option<E::Experience>)> = plan
@@ -100,7 +101,7 @@ pub fn execute<E: Executor>(
                     }
                     let (row, experience) = executor.run(spec, None);
                     progress.finished(&row);
-                    let keep = sources.contains(&spec.id);
+                    let keep = uses.contains_key(&spec.id);
                     (row, experience.filter(|_| keep))
                 })
                 .collect();
@@ -117,7 +118,7 @@ pub fn execute<E: Executor>(
             (rows, experiences)
         });
     // Runs with experience, in waves: each wave holds the runs whose source has
-    // ended (a grid run, or an accumulation run of an earlier wave).
+    // ended (a grid run, or an accumulation or drive run of an earlier wave).
     let mut experiences = experiences;
     let mut transfer: Vec<Option<RunRow>> = vec![None; plan.transfer.len()];
     let offset = plan.first.len();
@@ -136,15 +137,23 @@ pub fn execute<E: Executor>(
             wave.par_iter()
                 .map(|spec| {
                     let source = spec.experience_from.and_then(|id| experiences.get(&id));
-                    let (row, experience) = match source {
-                        Some(experience) => executor.run(spec, Some(experience)),
-                        None => {
-                            let from = (spec.experience_from)
-                                .and_then(|id| match id.checked_sub(offset) {
-                                    None => rows.get(id),
-                                    Some(i) => transfer.get(i).and_then(Option::as_ref),
-                                })
-                                .map_or_else(|| "none".to_owned(), RunSpec::label_of);
+                    let (row, experience) = match (spec.experience_from, source) {
+                        (Some(_), Some(experience)) => {
+                            let (row, learned) = executor.run(spec, Some(experience));
+                            (row, learned.or_else(|| passed_on(spec, experience)))
+                        }
+                        // A drive that has learned nothing yet (its first
+                        // scenes were refused) starts from scratch.
+                        (None, _) | (Some(_), None) if spec.experiment == Experiment::Drive => {
+                            executor.run(spec, None)
+                        }
+                        (None, _) => executor.run(spec, None),
+                        (Some(source), None) => {
+                            let from = (match source.checked_sub(offset) {
+                                None => rows.get(source),
+                                Some(i) => transfer.get(i).and_then(Option::as_ref),
+                            })
+                            .map_or_else(|| "none".to_owned(), RunSpec::label_of);
                             let reason = format!("no experience to start from: source run {from}");
                             let row = RunRow::without_result(
                                 (*spec).clone(),
@@ -159,11 +168,19 @@ pub fn execute<E: Executor>(
                         }
                     };
                     progress.finished(&row);
-                    let keep = sources.contains(&spec.id);
+                    let keep = uses.contains_key(&spec.id);
                     (row, experience.filter(|_| keep))
                 })
                 .collect()
         });
+        for source in wave.iter().filter_map(|s| s.experience_from) {
+            if let Some(left) = uses.get_mut(&source) {
+                *left -= 1;
+                if *left == 0 {
+                    experiences.remove(&source);
+                }
+            }
+        }
         for (row, experience) in done {
             if let Some(experience) = experience {
                 experiences.insert(row.spec.id, experience);
@@ -179,6 +196,12 @@ pub fn execute<E: Executor>(
     progress.done();
     debug_assert!(rows.iter().enumerate().all(|(i, row)| row.spec.id == i));
     Ok(rows)
+}
+
+/// What a run that learned nothing hands on: a drive goes on through a scene it
+/// could not drive (refused) with the experience it had; other runs hand on nothing.
+fn passed_on<X: Clone>(spec: &RunSpec, experience: &X) -> Option<X> {
+    (spec.experiment == Experiment::Drive).then(|| experience.clone())
 }
 
 /// The row of a run skipped because the evaluation was cancelled; never written.
@@ -412,6 +435,74 @@ pub(crate) mod tests {
                 assert!(row.takeovers <= without.takeovers);
             }
         }
+    }
+
+    /// Refuses every scene whose seed is odd; a run's experience is its id, and
+    /// its row's `takeovers` is the id of the run whose experience it started
+    /// from (`usize::MAX`: from scratch).
+    struct Chain;
+
+    impl Executor for Chain {
+        type Experience = usize;
+
+        fn run(&self, spec: &RunSpec, experience: Option<&usize>) -> (RunRow, Option<usize>) {
+            if spec.seed % 2 == 1 {
+                let status = Status::Refused {
+                    reason: "odd".into(),
+                    refusal: None,
+                };
+                return (RunRow::without_result(spec.clone(), status, 1, 0.0), None);
+            }
+            let mut row = RunRow::without_result(spec.clone(), Status::Personalized, 1, 0.0);
+            row.takeovers = experience.copied().unwrap_or(usize::MAX);
+            (row, Some(spec.id))
+        }
+
+        fn cap(&self) -> usize {
+            1
+        }
+    }
+
+    #[test]
+    fn a_drive_passes_its_experience_through_refused_scenes_and_starts_from_scratch_before_any() {
+        let mut selection = plan::tests::selection();
+        selection.users.truncate(1);
+        selection.transfer.users.clear();
+        selection.grid.methods = vec![Method::Palc];
+        selection.grid.styles = vec![StylePreset::Neutral];
+        let grid = selection.grid.clone();
+        let config = crate::drive::DriveConfig {
+            users: vec!["deterministic".into()],
+            lane_changes: Some(6),
+            grid_share: Some(1.0),
+            ..Default::default()
+        };
+        let mut scenes = config.scenes("drive", &grid).unwrap();
+        // Seeds: refused (odd), refused, driven, refused, driven, driven.
+        for (scene, seed) in scenes.iter_mut().zip([1, 3, 2, 5, 4, 6]) {
+            scene.seed = seed;
+        }
+        selection.drive = crate::config::Drive {
+            users: config.users.clone(),
+            scenes,
+        };
+        let plan = plan::expand(&selection, &plan::tests::testbed()).unwrap();
+        let rows = execute(&plan, &Chain, 2, &NoProgress).unwrap();
+        let drive: Vec<&RunRow> = (rows.iter())
+            .filter(|r| r.spec.experiment == Experiment::Drive)
+            .collect();
+        assert_eq!(drive.len(), 6);
+        let id = |i: usize| drive[i].spec.id;
+        assert_eq!(drive[0].spec.experience_from, None);
+        for i in 1..6 {
+            assert_eq!(drive[i].spec.experience_from, Some(id(i - 1)), "scene {i}");
+        }
+        let refused = |i: usize| matches!(drive[i].status, Status::Refused { .. });
+        assert!(refused(0) && refused(1) && refused(3));
+        // The first driven scene starts from scratch; the next from it, through the refused one.
+        assert_eq!(drive[2].takeovers, usize::MAX);
+        assert_eq!(drive[4].takeovers, id(2));
+        assert_eq!(drive[5].takeovers, id(4));
     }
 
     #[test]

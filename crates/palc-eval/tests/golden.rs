@@ -51,6 +51,7 @@ fn subset(evaluation: &Evaluation) -> Selection {
     selection.grid.headways_m = vec![40.0];
     selection.grid.styles = vec![StylePreset::Aggressive, StylePreset::Cautious];
     selection.grid.seeds = vec![1];
+    selection.drive = Default::default();
     selection
         .users
         .retain(|u| !u.has_spread() && !u.is_family());

@@ -325,6 +325,22 @@ impl LearningLoop {
             }
             self.step(observer)?;
         };
+        self.finish(outcome, observer)
+    }
+
+    /// Ends the run here with `outcome`, whatever [`LearningLoop::termination`]
+    /// says: the summary (after the evaluation phase of a user with spread, see
+    /// `loop.frozen_lane_changes`) is told to the observer and returned with the
+    /// records and the experience. A drive of varied scenes ends each scene after
+    /// one lane change this way.
+    ///
+    /// # Errors
+    /// Those of [`LearningLoop::step`], from the evaluation phase.
+    pub fn finish(
+        mut self,
+        outcome: Outcome,
+        observer: &mut dyn Observer,
+    ) -> Result<RunResult, HarnessError> {
         let mut summary = self.run.summary(outcome, &self.policy.stopping);
         summary.frozen = self.frozen_evaluation(observer)?;
         observer.finished(&summary);

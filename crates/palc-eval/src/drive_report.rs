@@ -1,0 +1,310 @@
+//! REPORT.md's "A drive of varied scenes" ([`crate::drive`]) and its figure: the
+//! takeover rate over a drive's lane changes, per method and user kind.
+//!
+//! A drive's lane changes are counted in driving order among the ones driven: a
+//! scene refused for the user (its standard ALC never starts, its start rule is
+//! met before the plan) is skipped, not counted. A lane change whose run failed
+//! (its experience planned off the road, a solver error) counts as taken over:
+//! the user would not have driven it.
+
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+
+use palc_harness::Method;
+
+use crate::figures::Lines;
+use crate::plan::Experiment;
+use crate::results::{RunRow, Status};
+
+/// The bands of lane changes the report gives a takeover rate for (first and
+/// last lane change, counted from 1 among the driven ones).
+pub const BANDS: [(usize, usize); 3] = [(1, 10), (11, 50), (51, 100)];
+
+/// The window of the figure's moving takeover rate (lane changes).
+const WINDOW: usize = 10;
+
+/// One drive: its lane changes in driving order, `true` where taken over (or failed).
+type Drive = Vec<bool>;
+
+/// The drives of one method and user kind.
+#[derive(Debug, Clone, PartialEq)]
+pub struct KindDrives {
+    /// The method.
+    pub method: Method,
+    /// The user kind.
+    pub user: String,
+    /// One drive per style (a recorded kind: per driver), in plan order.
+    pub drives: Vec<Drive>,
+    /// Scenes of all these drives.
+    pub scenes: usize,
+    /// Scenes refused (skipped).
+    pub refused: usize,
+    /// Lane changes whose run failed (counted as taken over).
+    pub failed: usize,
+}
+
+impl KindDrives {
+    /// Lane changes driven.
+    pub fn driven(&self) -> usize {
+        self.drives.iter().map(Vec::len).sum()
+    }
+
+    /// Takeovers and lane changes driven in the band `(first, last)`, over every drive.
+    pub fn band(&self, (first, last): (usize, usize)) -> (usize, usize) {
+        (self.drives.iter()).fold((0, 0), |(taken, driven), drive| {
+            let band = &drive[(first - 1).min(drive.len())..last.min(drive.len())];
+            (
+                taken + band.iter().filter(|&&t| t).count(),
+                driven + band.len(),
+            )
+        })
+    }
+
+    /// The takeover rate over the last [`WINDOW`] lane changes at each lane change
+    /// from the window's end on, over every drive that drove that far.
+    pub fn moving_rate(&self) -> Vec<(f64, f64)> {
+        let longest = self.drives.iter().map(Vec::len).max().unwrap_or(0);
+        (WINDOW..=longest)
+            .filter_map(|end| {
+                let windows = (self.drives.iter()).filter(|d| d.len() >= end);
+                let (taken, n) = windows.fold((0, 0), |(taken, n), d| {
+                    let window = &d[end - WINDOW..end];
+                    (taken + window.iter().filter(|&&t| t).count(), n + WINDOW)
+                });
+                (n > 0).then(|| (end as f64, taken as f64 / n as f64))
+            })
+            .collect()
+    }
+}
+
+/// The drives of `rows`, per method (in `methods` order) and user kind (in plan order).
+pub fn drives(rows: &[RunRow], methods: &[Method]) -> Vec<KindDrives> {
+    let mut out = Vec::new();
+    for &method in methods {
+        let of_method = rows
+            .iter()
+            .filter(|r| r.spec.experiment == Experiment::Drive && r.spec.method == method);
+        let mut users: Vec<&str> = Vec::new();
+        let mut by_drive: BTreeMap<(&str, &str), Vec<&RunRow>> = BTreeMap::new();
+        for row in of_method {
+            let user = row.spec.user.name.as_str();
+            if !users.contains(&user) {
+                users.push(user);
+            }
+            let drive = by_drive.entry((user, row.spec.style_name())).or_default();
+            drive.push(row);
+        }
+        for user in users {
+            let mut kind = KindDrives {
+                method,
+                user: user.to_owned(),
+                drives: Vec::new(),
+                scenes: 0,
+                refused: 0,
+                failed: 0,
+            };
+            for ((_, _), rows) in by_drive
+                .range((user, "")..)
+                .take_while(|((u, _), _)| *u == user)
+            {
+                let mut drive = Drive::new();
+                for row in rows {
+                    kind.scenes += 1;
+                    match &row.status {
+                        Status::Refused { .. } => kind.refused += 1,
+                        Status::Failed { .. } => {
+                            kind.failed += 1;
+                            drive.push(true);
+                        }
+                        Status::Personalized | Status::CapReached => {
+                            drive.push(row.counted_takeovers() > 0);
+                        }
+                    }
+                }
+                kind.drives.push(drive);
+            }
+            out.push(kind);
+        }
+    }
+    out
+}
+
+/// Writes the section; nothing without drive runs.
+pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
+    let kinds = drives(rows, methods);
+    if kinds.is_empty() {
+        return;
+    }
+    let _ = writeln!(out, "## A drive of varied scenes\n");
+    let _ = writeln!(
+        out,
+        "Each user kind drives a sequence of lane changes, one per scene and each scene new to it (half of them grid cells, \
+         half drawn around the grid: `[drive]` in the config), learning from every takeover throughout, once per style \
+         (a recorded kind: per driver). This is the takeover rate a driver would feel. A scene refused for the user is skipped \
+         and not counted; a lane change whose run failed counts as taken over. Rates are taken-over lane changes over the \
+         lane changes driven in each band (numbered among the driven ones), all drives of the kind together.\n"
+    );
+    let header: Vec<String> = (BANDS.iter())
+        .map(|(a, b)| format!("lane changes {a}-{b}"))
+        .collect();
+    let _ = writeln!(
+        out,
+        "| method | user | drives | scenes | driven | refused | failed | {} |",
+        header.join(" | ")
+    );
+    let _ = writeln!(out, "|{}", " --- |".repeat(7 + BANDS.len()));
+    for kind in &kinds {
+        let bands: Vec<String> = (BANDS.iter())
+            .map(|&band| match kind.band(band) {
+                (_, 0) => "-".to_owned(),
+                (taken, n) => format!("{:.0} % ({taken}/{n})", 100.0 * taken as f64 / n as f64),
+            })
+            .collect();
+        let _ = writeln!(
+            out,
+            "| {} | {} | {} | {} | {} | {} | {} | {} |",
+            kind.method.name(),
+            kind.user,
+            kind.drives.len(),
+            kind.scenes,
+            kind.driven(),
+            kind.refused,
+            kind.failed,
+            bands.join(" | ")
+        );
+    }
+    let _ = writeln!(out);
+}
+
+/// The figure of `method`'s drives: the moving takeover rate of each user kind,
+/// in groups of at most `per_figure` kinds (one figure each); none without drives.
+pub fn figures(rows: &[RunRow], method: Method, per_figure: usize) -> Vec<Lines> {
+    let kinds = drives(rows, &[method]);
+    let groups: Vec<&[KindDrives]> = kinds.chunks(per_figure.max(1)).collect();
+    let count = groups.len();
+    (groups.into_iter().enumerate())
+        .map(|(i, group)| Lines {
+            title: match count {
+                1 => format!(
+                    "Takeover rate over a drive of varied scenes ({})",
+                    method.name()
+                ),
+                _ => format!(
+                    "Takeover rate over a drive of varied scenes ({}, {} of {count})",
+                    method.name(),
+                    i + 1
+                ),
+            },
+            x_desc: "lane change of the drive (driven ones)".into(),
+            y_desc: format!("takeover rate over the last {WINDOW} (-)"),
+            series: (group.iter())
+                .map(|kind| (kind.user.clone(), kind.moving_rate()))
+                .filter(|(_, points)| !points.is_empty())
+                .collect(),
+            y_range: Some((0.0, 1.05)),
+            log_y: false,
+        })
+        .filter(|lines| !lines.series.is_empty())
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::UserKind;
+    use crate::plan::RunSpec;
+    use palc_harness::StylePreset;
+    use palc_traffic::SpeedCaseConfig;
+
+    /// A drive run of `user` (`style`), taken over or not, or refused or failed.
+    fn run(id: usize, user: &str, style: StylePreset, outcome: &str) -> RunRow {
+        let spec = RunSpec {
+            id,
+            experiment: Experiment::Drive,
+            method: Method::Palc,
+            user: UserKind {
+                name: user.into(),
+                ..UserKind::deterministic()
+            },
+            style,
+            speed_case: SpeedCaseConfig {
+                name: "collector-high".into(),
+                ego_mph: 45.0,
+                others_mph: 40.0,
+            },
+            headway_m: 40.0,
+            seed: 1,
+            dt: None,
+            horizon_margin_s: None,
+            experience_from: id.checked_sub(1),
+            rung: None,
+        };
+        let status = match outcome {
+            "T" => Status::CapReached,
+            "-" => Status::Personalized,
+            "F" => Status::Failed {
+                error: "off the road".into(),
+            },
+            _ => Status::Refused {
+                reason: "standard never starts".into(),
+                refusal: None,
+            },
+        };
+        let mut row = RunRow::without_result(spec, status, 1, 0.0);
+        row.takeovers = usize::from(outcome == "T");
+        row
+    }
+
+    fn drive(user: &str, style: StylePreset, outcomes: &str, first_id: usize) -> Vec<RunRow> {
+        (outcomes.chars().enumerate())
+            .map(|(i, c)| run(first_id + i, user, style, &c.to_string()))
+            .collect()
+    }
+
+    #[test]
+    fn refused_scenes_are_skipped_and_failed_lane_changes_count_as_taken_over() {
+        // 12 scenes: one refused, one failed; driven: T T - - F - - - - - - (11).
+        let mut rows = drive("deterministic", StylePreset::Neutral, "TTR--F------", 0);
+        rows.extend(drive(
+            "deterministic",
+            StylePreset::Cautious,
+            "-----------T",
+            12,
+        ));
+        let kinds = drives(&rows, &[Method::Palc]);
+        assert_eq!(kinds.len(), 1);
+        let kind = &kinds[0];
+        assert_eq!(
+            (kind.scenes, kind.refused, kind.failed, kind.driven()),
+            (24, 1, 1, 23)
+        );
+        // Lane changes 1-10: neutral T T - - F - - - - - (3), cautious 10 clean.
+        assert_eq!(kind.band((1, 10)), (3, 20));
+        // 11-50: neutral's 11th (clean), cautious's 11th and 12th (one taken over).
+        assert_eq!(kind.band((11, 50)), (1, 3));
+        assert_eq!(kind.band((51, 100)), (0, 0));
+        let rate = kind.moving_rate();
+        // Windows ending at 10 (both drives) and 11 (both) and 12 (cautious only).
+        assert_eq!(rate.len(), 3);
+        assert!((rate[0].1 - 3.0 / 20.0).abs() < 1e-12, "{rate:?}");
+        assert!((rate[2].1 - 1.0 / 10.0).abs() < 1e-12, "{rate:?}");
+    }
+
+    #[test]
+    fn the_section_states_each_band_and_nothing_without_drives() {
+        let mut out = String::new();
+        section(&mut out, &[], &[Method::Palc]);
+        assert!(out.is_empty());
+        let rows = drive("incentive", StylePreset::Aggressive, "T---------T", 0);
+        section(&mut out, &rows, &[Method::Paper, Method::Palc]);
+        assert!(out.contains("## A drive of varied scenes"), "{out}");
+        assert!(
+            out.contains(
+                "| palc | incentive | 1 | 11 | 11 | 0 | 0 | 10 % (1/10) | 100 % (1/1) | - |"
+            ),
+            "{out}"
+        );
+        assert_eq!(figures(&rows, Method::Palc, 6).len(), 1);
+        assert!(figures(&rows, Method::Paper, 6).is_empty());
+    }
+}
