@@ -77,13 +77,14 @@ impl KindDrives {
     }
 }
 
-/// The drives of `rows`, per method (in `methods` order) and user kind (in plan order).
-pub fn drives(rows: &[RunRow], methods: &[Method]) -> Vec<KindDrives> {
+/// The drives of `rows` (`experiment`: the drives, or their scenes from scratch),
+/// per method (in `methods` order) and user kind (in plan order).
+pub fn drives(rows: &[RunRow], methods: &[Method], experiment: Experiment) -> Vec<KindDrives> {
     let mut out = Vec::new();
     for &method in methods {
         let of_method = rows
             .iter()
-            .filter(|r| r.spec.experiment == Experiment::Drive && r.spec.method == method);
+            .filter(|r| r.spec.experiment == experiment && r.spec.method == method);
         let mut users: Vec<&str> = Vec::new();
         let mut by_drive: BTreeMap<(&str, &str), Vec<&RunRow>> = BTreeMap::new();
         for row in of_method {
@@ -131,7 +132,8 @@ pub fn drives(rows: &[RunRow], methods: &[Method]) -> Vec<KindDrives> {
 
 /// Writes the section; nothing without drive runs.
 pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
-    let kinds = drives(rows, methods);
+    let kinds = drives(rows, methods, Experiment::Drive);
+    let scratch = drives(rows, methods, Experiment::DriveFromScratch);
     if kinds.is_empty() {
         return;
     }
@@ -142,7 +144,9 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
          half drawn around the grid: `[drive]` in the config), learning from every takeover throughout, once per style \
          (a recorded kind: per driver). This is the takeover rate a driver would feel. A scene refused for the user is skipped \
          and not counted; a lane change whose run failed counts as taken over. Rates are taken-over lane changes over the \
-         lane changes driven in each band (numbered among the driven ones), all drives of the kind together.\n"
+         lane changes driven in each band (numbered among the driven ones), all drives of the kind together; \
+         beside each, the rate of the same lane changes driven without experience (every scene from scratch: \
+         the standard ALC's plan), which experience should never exceed.\n"
     );
     let header: Vec<String> = (BANDS.iter())
         .map(|(a, b)| format!("lane changes {a}-{b}"))
@@ -154,11 +158,20 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
     );
     let _ = writeln!(out, "|{}", " --- |".repeat(7 + BANDS.len()));
     for kind in &kinds {
+        let baseline = (scratch.iter()).find(|s| s.method == kind.method && s.user == kind.user);
+        let rate = |(taken, n): (usize, usize)| 100.0 * taken as f64 / n as f64;
         let bands: Vec<String> = (BANDS.iter())
-            .map(|&band| match kind.band(band) {
-                (_, 0) => "-".to_owned(),
-                (taken, n) => format!("{:.0} % ({taken}/{n})", 100.0 * taken as f64 / n as f64),
-            })
+            .map(
+                |&band| match (kind.band(band), baseline.map(|b| b.band(band))) {
+                    ((_, 0), _) => "-".to_owned(),
+                    ((taken, n), Some(scratch)) if scratch.1 > 0 => format!(
+                        "{:.0} % ({taken}/{n}); from scratch {:.0} %",
+                        rate((taken, n)),
+                        rate(scratch)
+                    ),
+                    ((taken, n), _) => format!("{:.0} % ({taken}/{n})", rate((taken, n))),
+                },
+            )
             .collect();
         let _ = writeln!(
             out,
@@ -179,7 +192,7 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
 /// The figure of `method`'s drives: the moving takeover rate of each user kind,
 /// in groups of at most `per_figure` kinds (one figure each); none without drives.
 pub fn figures(rows: &[RunRow], method: Method, per_figure: usize) -> Vec<Lines> {
-    let kinds = drives(rows, &[method]);
+    let kinds = drives(rows, &[method], Experiment::Drive);
     let groups: Vec<&[KindDrives]> = kinds.chunks(per_figure.max(1)).collect();
     let count = groups.len();
     (groups.into_iter().enumerate())
@@ -271,7 +284,7 @@ mod tests {
             "-----------T",
             12,
         ));
-        let kinds = drives(&rows, &[Method::Palc]);
+        let kinds = drives(&rows, &[Method::Palc], Experiment::Drive);
         assert_eq!(kinds.len(), 1);
         let kind = &kinds[0];
         assert_eq!(
@@ -295,15 +308,17 @@ mod tests {
         let mut out = String::new();
         section(&mut out, &[], &[Method::Palc]);
         assert!(out.is_empty());
-        let rows = drive("incentive", StylePreset::Aggressive, "T---------T", 0);
+        let mut rows = drive("incentive", StylePreset::Aggressive, "T---------T", 0);
+        let mut scratch = drive("incentive", StylePreset::Aggressive, "TTTTT-----T", 11);
+        for row in &mut scratch {
+            row.spec.experiment = Experiment::DriveFromScratch;
+        }
+        rows.extend(scratch);
         section(&mut out, &rows, &[Method::Paper, Method::Palc]);
         assert!(out.contains("## A drive of varied scenes"), "{out}");
-        assert!(
-            out.contains(
-                "| palc | incentive | 1 | 11 | 11 | 0 | 0 | 10 % (1/10) | 100 % (1/1) | - |"
-            ),
-            "{out}"
-        );
+        let line = "| palc | incentive | 1 | 11 | 11 | 0 | 0 | 10 % (1/10); from scratch 50 % | \
+                    100 % (1/1); from scratch 100 % | - |";
+        assert!(out.contains(line), "{out}");
         assert_eq!(figures(&rows, Method::Palc, 6).len(), 1);
         assert!(figures(&rows, Method::Paper, 6).is_empty());
     }

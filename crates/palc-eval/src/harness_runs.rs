@@ -138,7 +138,7 @@ impl HarnessRuns {
         if spec.experiment == Experiment::ClosedLoop {
             config.planning.closed_loop.enabled = true;
         }
-        if spec.experiment == Experiment::Drive {
+        if spec.experiment.is_drive() {
             // A drive's scene is driven once: no evaluation phase after it, and
             // a drawn speed case joins the test bed's.
             config.stopping.frozen_lane_changes = 0;
@@ -198,7 +198,9 @@ impl Executor for HarnessRuns {
         };
         let mut recorder = RowRecorder::default();
         let result = match spec.experiment {
-            Experiment::Drive => one_lane_change(&config, experience, &mut recorder),
+            Experiment::Drive | Experiment::DriveFromScratch => {
+                one_lane_change(&config, experience, &mut recorder)
+            }
             _ => palc_harness::run(&config, experience, &mut recorder),
         };
         let wall_s = start.elapsed().as_secs_f64();
@@ -236,7 +238,7 @@ impl Executor for HarnessRuns {
 /// the loop's cap.
 fn cap_of(spec: &RunSpec, cap: usize) -> usize {
     match spec.experiment {
-        Experiment::Drive => 1,
+        Experiment::Drive | Experiment::DriveFromScratch => 1,
         _ => cap,
     }
 }

@@ -36,6 +36,8 @@ pub enum Experiment {
     /// One lane change of a drive of varied scenes (`[drive]`, [`crate::drive`]),
     /// started with the experience of the drive's lane change before it.
     Drive,
+    /// A scene of a drive driven once without experience: the drive's baseline.
+    DriveFromScratch,
 }
 
 impl Experiment {
@@ -51,7 +53,15 @@ impl Experiment {
             Experiment::Ablation => "ablation",
             Experiment::AblationTransfer => "ablation-transfer",
             Experiment::Drive => "drive",
+            Experiment::DriveFromScratch => "drive-from-scratch",
         }
+    }
+}
+
+impl Experiment {
+    /// Whether a run of this experiment is one lane change of a drive ([`crate::drive`]).
+    pub fn is_drive(self) -> bool {
+        matches!(self, Experiment::Drive | Experiment::DriveFromScratch)
     }
 }
 
@@ -449,7 +459,8 @@ fn styled(grid: &Grid, user: &UserKind, drivers: &[String]) -> Vec<(StylePreset,
 /// Appends the drives of `selection` to `transfer` (whose first id is
 /// `offset`): per method, drive user and style (or recorded driver), one chain
 /// of runs through the drive's scenes, each but the first starting from the one
-/// before it.
+/// before it; then every scene of each drive once without experience, the
+/// drive's baseline (in `transfer` too, so that no earlier run's id moves).
 fn drives(
     selection: &Selection,
     transfer: &mut Vec<RunSpec>,
@@ -458,7 +469,10 @@ fn drives(
 ) -> Result<(), EvalError> {
     let grid = &selection.grid;
     let drive = &selection.drive;
-    for method in &grid.methods {
+    for (experiment, method) in [Experiment::Drive, Experiment::DriveFromScratch]
+        .into_iter()
+        .flat_map(|e| grid.methods.iter().map(move |m| (e, m)))
+    {
         for user in (selection.users.iter()).filter(|u| drive.users.contains(&u.name)) {
             let drivers = (selection.drivers.get(&user.name)).map_or(&[][..], Vec::as_slice);
             for (style, user) in styled(grid, user, drivers) {
@@ -468,7 +482,7 @@ fn drives(
                     room(id, max_runs)?;
                     transfer.push(RunSpec {
                         id,
-                        experiment: Experiment::Drive,
+                        experiment,
                         method: *method,
                         user: user.clone(),
                         style,
@@ -480,7 +494,7 @@ fn drives(
                         experience_from: previous,
                         rung: None,
                     });
-                    previous = Some(id);
+                    previous = (experiment == Experiment::Drive).then_some(id);
                 }
             }
         }
