@@ -7,16 +7,18 @@
 //! takeover rate over the drive is the number a driver would feel.
 //!
 //! The scenes are drawn once per drive config ([`DriveConfig::scenes`]), so every
-//! user, style and method meets the same sequence: a share `grid_share` are cells
-//! of the evaluation's grid (speed case, headway, seed), the rest are drawn
-//! uniformly from ranges around it (the ego's speed, the other vehicles' speed
-//! below it, the target lane's headway) with a new scene seed, scenes no other
-//! experiment uses. A scene in which a user's run is refused (its standard ALC
+//! user, style and method meets the same sequence, and no scene comes twice: a
+//! share `grid_share` are cells of the evaluation's grid (speed case, headway,
+//! seed), each at most once, in a random order; the rest, and every scene once
+//! the cells are used up, are drawn uniformly from ranges around the grid (the
+//! ego's speed, the other vehicles' speed below it, the target lane's headway)
+//! with a new scene seed, scenes no other experiment uses. A scene in which a user's run is refused (its standard ALC
 //! never starts, its start rule is met before the plan) is skipped for that user:
 //! the experience passes through it unchanged (the runner's
 //! [`crate::runner::execute`]) and the lane change is not counted.
 
 use palc_traffic::SpeedCaseConfig;
+use rand::seq::SliceRandom;
 use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
@@ -158,6 +160,19 @@ impl DriveConfig {
             ));
         }
         let share = self.grid_share.unwrap_or(0.5);
+        let mut cells: Vec<DriveScene> = (grid.speed_cases.iter())
+            .flat_map(|case| {
+                (grid.headways_m.iter()).flat_map(move |&headway_m| {
+                    (grid.seeds.iter()).map(move |&seed| DriveScene {
+                        speed_case: case.clone(),
+                        headway_m,
+                        seed,
+                    })
+                })
+            })
+            .collect();
+        cells.shuffle(&mut rng);
+        let mut cells = cells.into_iter();
         let draw = |rng: &mut ChaCha8Rng, [low, high]: [f64; 2]| {
             if low < high {
                 rng.random_range(low..=high)
@@ -167,25 +182,17 @@ impl DriveConfig {
         };
         let mut scenes = Vec::with_capacity(self.lane_changes());
         for _ in 0..self.lane_changes() {
-            // Every draw is taken in both branches, so the sequence of drawn
+            // Every draw is taken whichever the scene, so the sequence of drawn
             // scenes does not depend on which scenes are grid cells.
             let on_grid = rng.random_range(0.0..1.0) < share;
-            let pick = |rng: &mut ChaCha8Rng, n: usize| rng.random_range(0..n.max(1));
-            let case = &grid.speed_cases[pick(&mut rng, grid.speed_cases.len())];
-            let grid_headway = grid.headways_m[pick(&mut rng, grid.headways_m.len())];
-            let grid_seed = grid.seeds[pick(&mut rng, grid.seeds.len())];
             let ego_mph = round(draw(&mut rng, ego));
             let others_mph = round(ego_mph - draw(&mut rng, difference));
             let headway_m = round(draw(&mut rng, headway));
             let seed = rng.random_range(DRAWN_SEEDS);
-            scenes.push(if on_grid {
-                DriveScene {
-                    speed_case: case.clone(),
-                    headway_m: grid_headway,
-                    seed: grid_seed,
-                }
-            } else {
-                DriveScene {
+            let cell = if on_grid { cells.next() } else { None };
+            scenes.push(match cell {
+                Some(cell) => cell,
+                None => DriveScene {
                     speed_case: SpeedCaseConfig {
                         name: format!("drawn-{ego_mph}-{others_mph}"),
                         ego_mph,
@@ -193,7 +200,7 @@ impl DriveConfig {
                     },
                     headway_m,
                     seed,
-                }
+                },
             });
         }
         Ok(scenes)
@@ -275,12 +282,12 @@ mod tests {
             ..config.clone()
         };
         assert_ne!(scenes, other.scenes("drive", &grid()).unwrap());
+        // Every grid cell once (2 cases x 2 headways x 2 seeds), no scene twice.
         let on_grid = scenes.iter().filter(|s| s.seed <= 2).count();
-        // About half are grid cells (binomial, 400 draws: 5 standard deviations is 50).
-        assert!(
-            (150..=250).contains(&on_grid),
-            "{on_grid} of 400 on the grid"
-        );
+        assert_eq!(on_grid, 8);
+        for (i, scene) in scenes.iter().enumerate() {
+            assert!(!scenes[..i].contains(scene), "scene {i} again: {scene:?}");
+        }
         for scene in scenes.iter().filter(|s| s.seed > 2) {
             let case = &scene.speed_case;
             assert!((40.0..=70.0).contains(&case.ego_mph), "{case:?}");
@@ -304,23 +311,18 @@ mod tests {
         };
         let drawn = all_drawn.scenes("drive", &grid()).unwrap();
         let cells = all_grid.scenes("drive", &grid()).unwrap();
-        assert!(
-            drawn
-                .iter()
-                .all(|s| s.speed_case.name.starts_with("drawn-"))
-        );
-        assert!(
-            cells
-                .iter()
-                .all(|s| s.seed <= 2 && !s.speed_case.name.starts_with("drawn-"))
-        );
+        let is_drawn = |s: &DriveScene| s.speed_case.name.starts_with("drawn-");
+        assert!(drawn.iter().all(is_drawn));
+        // The eight cells first, then, used up, drawn scenes: the same as without cells.
+        assert!(cells[..8].iter().all(|s| s.seed <= 2 && !is_drawn(s)));
+        assert_eq!(cells[8..], drawn[8..]);
         let half = DriveConfig {
             grid_share: Some(0.5),
             ..all_drawn.clone()
         };
         for (i, scene) in half.scenes("drive", &grid()).unwrap().iter().enumerate() {
             assert!(
-                scene == &drawn[i] || scene == &cells[i],
+                scene == &drawn[i] || cells[..8].contains(scene),
                 "scene {i}: {scene:?}"
             );
         }
