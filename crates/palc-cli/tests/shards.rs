@@ -33,6 +33,11 @@ name = "deterministic"
 source = "next-speed-case"
 users = ["deterministic"]
 
+[drive]
+users = ["deterministic"]
+lane_changes = 12
+seed = {seed}
+
 [timing]
 methods = ["palc"]
 dts = [0.1]
@@ -143,6 +148,8 @@ fn four_shards_merged_equal_one_run_and_mismatched_parts_are_refused() {
     succeeds(&palc(&merge, &dir));
     let whole = runs_without_times(&dir.join("whole"));
     assert!(whole.len() > 8, "too few runs to test: {}", whole.len());
+    // Two drives (a style each) are chains of 12 runs, each starting from the one before.
+    assert_eq!(whole.iter().filter(|r| r.contains(",drive,")).count(), 24);
     assert_eq!(whole, runs_without_times(&dir.join("merged")));
     let refusals = |d: &str| std::fs::read_to_string(dir.join(d).join("refusals.csv")).unwrap();
     assert_eq!(refusals("whole"), refusals("merged"));
