@@ -290,6 +290,8 @@ pub struct Selection {
 pub struct Drive {
     /// Names of the user kinds that drive.
     pub users: Vec<String>,
+    /// The methods that drive.
+    pub methods: Vec<Method>,
     /// The scenes, in driving order.
     pub scenes: Vec<DriveScene>,
 }
@@ -324,6 +326,7 @@ impl EvalConfig {
             let grid = self.grid.resolve("grid", testbed)?;
             let drive = Drive {
                 users: self.drive.users.clone(),
+                methods: (self.drive.methods.clone()).unwrap_or_else(|| grid.methods.clone()),
                 scenes: self.drive.scenes("drive", &grid)?,
             };
             return Ok(Selection {
@@ -356,6 +359,7 @@ impl EvalConfig {
         let grid = self.quick.grid.resolve("quick.grid", testbed)?;
         let drive = Drive {
             users: self.quick.drive.users.clone(),
+            methods: (self.quick.drive.methods.clone()).unwrap_or_else(|| grid.methods.clone()),
             scenes: self.quick.drive.scenes("quick.drive", &grid)?,
         };
         Ok(Selection {

@@ -23,6 +23,8 @@ use rand::{RngExt, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::{Deserialize, Serialize};
 
+use palc_harness::Method;
+
 use crate::EvalError;
 use crate::config::Grid;
 
@@ -55,9 +57,11 @@ const DRAWN_SEEDS: std::ops::RangeInclusive<u64> = 1_000..=1_000_000;
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DriveConfig {
-    /// Names of the user kinds that drive (every style of the grid, every method
-    /// of the grid); none: no drive.
+    /// Names of the user kinds that drive (every style of the grid); none: no drive.
     pub users: Vec<String>,
+    /// The methods that drive; the grid's when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub methods: Option<Vec<Method>>,
     /// Lane changes (scenes) per drive; [`DEFAULT_LANE_CHANGES`] when left out.
     #[serde(default)]
     pub lane_changes: Option<usize>,
@@ -105,6 +109,13 @@ impl DriveConfig {
     /// Checks the numbers of `[table]` (`drive` or `quick.drive`); names are
     /// checked by the evaluation config.
     pub fn validate(&self, table: &str) -> Result<(), EvalError> {
+        if self.methods.as_ref().is_some_and(Vec::is_empty) {
+            return Err(EvalError::invalid(
+                format!("{table}.methods"),
+                "empty",
+                "at least one method (leave it out for the grid's)",
+            ));
+        }
         if let Some(n) = self.lane_changes {
             if !(1..=MAX_LANE_CHANGES).contains(&n) {
                 return Err(EvalError::invalid(
@@ -239,7 +250,7 @@ fn round(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use palc_harness::{Method, StylePreset};
+    use palc_harness::StylePreset;
 
     fn grid() -> Grid {
         Grid {

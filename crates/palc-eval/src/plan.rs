@@ -471,7 +471,7 @@ fn drives(
     let drive = &selection.drive;
     for (experiment, method) in [Experiment::Drive, Experiment::DriveFromScratch]
         .into_iter()
-        .flat_map(|e| grid.methods.iter().map(move |m| (e, m)))
+        .flat_map(|e| drive.methods.iter().map(move |m| (e, m)))
     {
         for user in (selection.users.iter()).filter(|u| drive.users.contains(&u.name)) {
             let drivers = (selection.drivers.get(&user.name)).map_or(&[][..], Vec::as_slice);

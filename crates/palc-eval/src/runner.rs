@@ -484,6 +484,7 @@ pub(crate) mod tests {
         }
         selection.drive = crate::config::Drive {
             users: config.users.clone(),
+            methods: vec![Method::Palc],
             scenes,
         };
         let plan = plan::expand(&selection, &plan::tests::testbed()).unwrap();

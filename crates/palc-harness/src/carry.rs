@@ -10,6 +10,7 @@ use palc_aggregator::{
 use palc_planner::{Planner, Problem, State, Weights};
 
 use crate::HarnessError;
+use crate::driver::start_beyond_readings;
 use crate::lesson::scenes;
 use crate::onset::{UserLaneChange, predicted_start_s};
 use crate::setup::Setup;
@@ -71,7 +72,8 @@ pub(crate) fn starting_experience(
             let lane_change = (previous.demonstration.as_deref())
                 .and_then(|path| UserLaneChange::fit(path, 0, previous.metadata.dt, setup.target_l))
                 .map_or(settled, |fitted| fitted.duration_s.max(settled));
-            (predicted_start_s(setup, &previous.onsets, lane_change))
+            (start_beyond_readings(setup, &previous.onsets, lane_change))
+                .or_else(|| predicted_start_s(setup, &previous.onsets, lane_change))
                 .map(|start| (anchor, start.min(latest)))
         }
         _ => None,

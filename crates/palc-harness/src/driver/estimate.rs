@@ -315,6 +315,16 @@ impl DriverEstimate {
         )
     }
 
+    /// The cue with the largest posterior mass, and that mass.
+    pub fn dominant_cue(&self) -> (Cue, f64) {
+        let masses = self.cue_masses();
+        let (i, mass) =
+            (masses.iter().enumerate()).fold((0, f64::NEG_INFINITY), |best, (i, &(_, m))| {
+                if m > best.1 { (i, m) } else { best }
+            });
+        (self.grid.cues[i].0, mass)
+    }
+
     /// The posterior mass of each cue.
     pub fn cue_masses(&self) -> Vec<(&'static str, f64)> {
         let weights = self.weights();
@@ -537,6 +547,87 @@ mod tests {
             contradicted.predict(seen, dt, speed, None, 2.0),
             Prediction::OutsideModel
         );
+    }
+
+    /// The scenes of the default config among every speed case, two headways and
+    /// two seeds that the loop prepares (some refuse: the standard ALC never starts).
+    fn more_scenes() -> Vec<crate::setup::Setup> {
+        let text = include_str!("../../../../configs/learn.toml");
+        let base = crate::config::LearnConfig::from_toml_str(text).unwrap();
+        let cases = [
+            "collector-high",
+            "collector-slow",
+            "arterial-high",
+            "arterial-slow",
+        ];
+        (cases.iter())
+            .flat_map(|case| [30.0, 50.0].map(|h| (case, h)))
+            .flat_map(|(case, headway_m)| [1, 2].map(|seed| (case, headway_m, seed)))
+            .filter_map(|(case, headway_m, seed)| {
+                let cell = crate::config::CellChoice {
+                    speed_case: (*case).into(),
+                    headway_m,
+                    seed,
+                };
+                crate::scenario::prepare(&base.clone().with_cell(cell)).ok()
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_estimate_predicts_a_driver_the_readings_cannot_read_once_the_scenes_single_it_out() {
+        use super::super::start_beyond_readings;
+        let setups = more_scenes();
+        let driver = |cue: Cue, threshold: f64| {
+            let (rule, time_headway_s) = cue.rule(threshold);
+            StartModel {
+                rule,
+                time_headway_s,
+                reaction_s: 0.0,
+                min_lead_gap_s: 0.0,
+                min_lag_gap_s: 0.0,
+            }
+        };
+        let incentive = driver(Cue::Incentive, 0.3);
+        let onsets: Vec<(usize, Onset)> = (0..setups.len())
+            .filter_map(|i| observed(&incentive, &setups[i]).map(|o| (i, o)))
+            .collect();
+        let (last, seen) = onsets
+            .split_last()
+            .expect("the incentive driver starts somewhere");
+        let (target, expected) = (last.0, last.1.time_s);
+        let seen: Vec<Onset> = seen.iter().map(|(_, o)| o.clone()).collect();
+        // One scene is explained by a threshold of every cue: the readings predict.
+        assert_eq!(
+            start_beyond_readings(&setups[target], &seen[..1], 2.0),
+            None
+        );
+        let estimate = DriverEstimate::from_onsets(&seen, 2.0).unwrap();
+        assert_eq!(
+            estimate.dominant_cue().0,
+            Cue::Incentive,
+            "{}",
+            estimate.describe()
+        );
+        assert!(
+            estimate.dominant_cue().1 >= super::super::CREDIBLE_MASS,
+            "{}",
+            estimate.describe()
+        );
+        let predicted = start_beyond_readings(&setups[target], &seen, 2.0);
+        let predicted = predicted.expect("the scenes single the incentive out");
+        let dt = setups[target].dt;
+        assert!(
+            (predicted - expected).abs() < dt / 2.0,
+            "{predicted} against {expected}"
+        );
+        // A headway driver is the readings' to predict, however many scenes.
+        let headway = driver(Cue::TimeHeadway, 1.2);
+        let seen: Vec<Onset> = (setups.iter())
+            .filter_map(|s| observed(&headway, s))
+            .collect();
+        assert!(seen.len() >= 2);
+        assert_eq!(start_beyond_readings(&setups[0], &seen, 2.0), None);
     }
 
     #[test]

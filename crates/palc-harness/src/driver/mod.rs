@@ -17,10 +17,14 @@
 //! [`prior::MISFIT_SDS`] standard deviations, the driver is outside the model.
 //!
 //! `palc learn` prints the estimate after a run. The start carried into a new
-//! scene is still predicted by the onsets' readings (`crate::onset`): as the
-//! predictor, the estimate's most probable model (and, separately, a refusal to
-//! carry a start for a driver outside the model) cost more takeovers on the
-//! evaluation's grid (docs/experiments/0068-one-driver-model.md).
+//! scene is predicted by the onsets' readings (`crate::onset`), which read the
+//! time headway, the time to collision and the distance gap; as the predictor
+//! for those cues the estimate's most probable model (and, separately, a refusal
+//! to carry a start for a driver outside the model) cost more takeovers on the
+//! evaluation's grid (docs/experiments/0068-one-driver-model.md). For a driver
+//! whose decision the estimate places on a cue the readings do not read (MOBIL's
+//! incentive), the estimate predicts ([`start_beyond_readings`],
+//! docs/experiments/0073-a-drive-of-varied-scenes.md).
 
 mod estimate;
 pub mod prior;
@@ -28,3 +32,56 @@ mod scene;
 
 pub use estimate::{DriverEstimate, Prediction};
 pub(crate) use scene::scene_steps;
+
+use palc_aggregator::Onset;
+
+use crate::setup::Setup;
+use prior::Cue;
+
+/// The cues the onsets' readings read (`crate::onset::predicted_start_s`).
+const READ_BY_THE_READINGS: [Cue; 3] = [Cue::TimeHeadway, Cue::TimeToCollision, Cue::DistanceGap];
+
+/// The posterior mass a cue the readings do not read must hold before the
+/// estimate predicts: the usual 95 % credibility. One scene never gives it when
+/// another cue explains the same start with a longer reaction (a reaction user's
+/// start, read as an incentive decision, cost it takeovers at a majority of 50 %).
+const CREDIBLE_MASS: f64 = 0.95;
+
+/// The scenes the estimate must have seen before it predicts: one scene is
+/// explained by a threshold of every cue, so it cannot single one out.
+const MIN_SCENES: usize = 2;
+
+/// The start (s after the start of the plan) the estimate predicts in `setup`
+/// for a lane change of `duration_s`, when the estimate from `onsets` places the
+/// decision on a cue the readings do not read, with [`CREDIBLE_MASS`] of the
+/// posterior, from at least [`MIN_SCENES`] scenes: the readings cannot represent
+/// such a driver, the estimate can. `None` otherwise (the readings predict), and
+/// for a driver outside the model or a scene the estimate says it does not start in.
+pub(crate) fn start_beyond_readings(
+    setup: &Setup,
+    onsets: &[Onset],
+    duration_s: f64,
+) -> Option<f64> {
+    // Only onsets that recorded their scene inform the estimate.
+    if onsets.iter().filter(|o| o.scene.is_some()).count() < MIN_SCENES {
+        return None;
+    }
+    let estimate = DriverEstimate::from_onsets(onsets, duration_s)?;
+    let (cue, mass) = estimate.dominant_cue();
+    if READ_BY_THE_READINGS.contains(&cue) || mass < CREDIBLE_MASS {
+        return None;
+    }
+    let steps = scene_steps(setup);
+    let safe: Option<Vec<bool>> = steps.steps.iter().map(|s| s.safe).collect();
+    let predicted = estimate.predict(
+        &setup.situations,
+        setup.dt,
+        setup.set_speed,
+        safe.as_deref(),
+        duration_s,
+    );
+    match predicted {
+        Prediction::Start(start_s) => Some(start_s),
+        Prediction::NoStart | Prediction::OutsideModel => None,
+    }
+}
