@@ -140,8 +140,8 @@ pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
     let _ = writeln!(out, "## A drive of varied scenes\n");
     let _ = writeln!(
         out,
-        "Each user kind drives a sequence of lane changes, one per scene and each scene new to it (half of them grid cells, \
-         half drawn around the grid: `[drive]` in the config), learning from every takeover throughout, once per style \
+        "Each user kind drives a sequence of lane changes, one per scene and no scene twice (grid cells, each at most once, \
+         and scenes drawn around the grid: `[drive]` in the config), learning from every takeover throughout, once per style \
          (a recorded kind: per driver). This is the takeover rate a driver would feel. A scene refused for the user is skipped \
          and not counted; a lane change whose run failed counts as taken over. Rates are taken-over lane changes over the \
          lane changes driven in each band (numbered among the driven ones), all drives of the kind together; \
