@@ -34,8 +34,26 @@ pub fn measure(results: &Results, user: &str) -> Vec<(&'static Claim, Vec<Measur
         .collect()
 }
 
+/// One table row per claim shown for `user`: name, the paper's value, each
+/// method's measurement and the verdicts.
+pub fn rows(results: &Results, user: &str, out: &mut Out) -> fmt::Result {
+    let cap = results.cap().to_string();
+    for (claim, measured) in measure(results, user) {
+        let cells: Vec<String> = measured.iter().map(|m| claim.cell(m)).collect();
+        writeln!(
+            out,
+            "| {} | {} | {} | {} |",
+            claim.name.replace("{cap}", &cap),
+            claim.claimed,
+            cells.join(" | "),
+            verdicts(results, claim, &measured)
+        )?;
+    }
+    Ok(())
+}
+
 /// The verdicts of one claim, `method: verdict` for each method.
-pub fn verdicts(results: &Results, claim: &Claim, measured: &[Measured]) -> String {
+fn verdicts(results: &Results, claim: &Claim, measured: &[Measured]) -> String {
     let verdicts: Vec<String> = (results.methods().iter().zip(measured))
         .map(|(method, m)| format!("{}: {}", method.name(), claim.verdict(m)))
         .collect();

@@ -48,18 +48,7 @@ fn claims(results: &Results, out: &mut Out) -> fmt::Result {
     columns.extend(results.methods().iter().map(|m| format!("`{}`", m.name())));
     columns.push("verdict".to_owned());
     header(out, &columns.iter().map(String::as_str).collect::<Vec<_>>())?;
-    let cap = results.cap().to_string();
-    for (claim, measured) in super::claims::measure(results, user) {
-        let cells: Vec<String> = measured.iter().map(|m| claim.cell(m)).collect();
-        writeln!(
-            out,
-            "| {} | {} | {} | {} |",
-            claim.name.replace("{cap}", &cap),
-            claim.claimed,
-            cells.join(" | "),
-            super::claims::verdicts(results, claim, &measured)
-        )?;
-    }
+    super::claims::rows(results, user, out)?;
     writeln!(out)
 }
 

@@ -69,31 +69,12 @@ fn user_kind(results: &Results, user: &str, out: &mut Out) -> fmt::Result {
         None => "Deterministic users are the paper's set-up.".to_owned(),
     };
     writeln!(out, "{cells} grid runs per method. {who}\n")?;
-    let header: Vec<String> = (methods.iter())
-        .map(|m| format!("`{}` method", m.name()))
-        .collect();
-    writeln!(
-        out,
-        "| metric | paper's claim | {} | verdict |",
-        header.join(" | ")
-    )?;
-    writeln!(out, "| --- | --- |{} --- |", " --- |".repeat(methods.len()))?;
-    let cap = results.cap().to_string();
-    for (claim, measured) in super::claims::measure(results, user) {
-        let cells: Vec<String> = measured.iter().map(|m| claim.cell(m)).collect();
-        writeln!(
-            out,
-            "| {} | {} | {} | {} |",
-            claim.name.replace("{cap}", &cap),
-            claim.claimed,
-            cells.join(" | "),
-            super::claims::verdicts(results, claim, &measured)
-        )?;
+    let first = results.input.users.first().is_some_and(|u| u == user);
+    if first && spread.is_none() {
+        writeln!(out, "The paper's claims on these users are the report's first table.\n")?;
+    } else {
+        claims_table(results, user, &grids, spread.is_some(), out)?;
     }
-    if spread.is_some() {
-        ceiling_lines(results, &grids, out)?;
-    }
-    writeln!(out)?;
     sensitivity(results, user, &grids, out);
     let rarely: Vec<String> = (methods.iter().zip(&grids))
         .map(|(m, g)| (m, Summary::of(g.iter().copied())))
@@ -115,6 +96,32 @@ fn user_kind(results: &Results, user: &str, out: &mut Out) -> fmt::Result {
         writeln!(out, "{text}\n")?;
     }
     Ok(())
+}
+
+/// The claims measured on `user`'s runs of each method, with a verdict each;
+/// for users with spread (`spread`), the ceiling lines after them.
+fn claims_table(
+    results: &Results,
+    user: &str,
+    grids: &[&[&RunRow]],
+    spread: bool,
+    out: &mut Out,
+) -> fmt::Result {
+    let methods = results.methods();
+    let header: Vec<String> = (methods.iter())
+        .map(|m| format!("`{}` method", m.name()))
+        .collect();
+    writeln!(
+        out,
+        "| metric | paper's claim | {} | verdict |",
+        header.join(" | ")
+    )?;
+    writeln!(out, "| --- | --- |{} --- |", " --- |".repeat(methods.len()))?;
+    super::claims::rows(results, user, out)?;
+    if spread {
+        ceiling_lines(results, grids, out)?;
+    }
+    writeln!(out)
 }
 
 /// Users with spread: the final takeover rate against the ceiling (the rate of
