@@ -9,7 +9,6 @@
 //! the key's SHA-256.
 
 use std::collections::HashMap;
-use std::fmt::Write as _;
 
 use sha2::{Digest, Sha256};
 
@@ -53,11 +52,9 @@ pub fn key(spec: &RunSpec, source: Option<&str>) -> String {
 /// The id of a key.
 fn hash(key: &str) -> String {
     let digest = Sha256::digest(key.as_bytes());
-    let mut id = String::with_capacity(ID_HEX);
-    for byte in digest.iter().take(ID_HEX / 2) {
-        let _ = write!(id, "{byte:02x}");
-    }
-    id
+    (digest.iter().take(ID_HEX / 2))
+        .map(|byte| format!("{byte:02x}"))
+        .collect()
 }
 
 /// The ids of `specs`, in their order; `experience_from` is looked up by

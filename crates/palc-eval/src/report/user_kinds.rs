@@ -71,7 +71,10 @@ fn user_kind(results: &Results, user: &str, out: &mut Out) -> fmt::Result {
     writeln!(out, "{cells} grid runs per method. {who}\n")?;
     let first = results.input.users.first().is_some_and(|u| u == user);
     if first && spread.is_none() {
-        writeln!(out, "The paper's claims on these users are the report's first table.\n")?;
+        writeln!(
+            out,
+            "The paper's claims on these users are the report's first table.\n"
+        )?;
     } else {
         claims_table(results, user, &grids, spread.is_some(), out)?;
     }
