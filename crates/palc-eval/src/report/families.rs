@@ -60,15 +60,8 @@ impl Section for Families {
                 if target.judge(&cases) == Verdict::NotMeasured {
                     continue;
                 }
-                writeln!(
-                    out,
-                    "- `{}`: target, {}: {}: {} ({}).",
-                    method.name(),
-                    target.name,
-                    target.rule.describe(),
-                    target.judge(&cases),
-                    target.summary(&cases)
-                )?;
+                let who = format!("`{}`, each user kind", method.name());
+                writeln!(out, "- {}", target.state_cases(&who, &cases))?;
             }
         }
         writeln!(out)?;

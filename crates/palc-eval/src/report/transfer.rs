@@ -74,15 +74,8 @@ impl Section for Transfer {
             if accumulation.judge(&cases) == Verdict::NotMeasured {
                 continue;
             }
-            writeln!(
-                out,
-                "- Target, {} (`{}`, each user kind and axis): {}: {} ({}).",
-                accumulation.name,
-                method.name(),
-                accumulation.rule.describe(),
-                accumulation.judge(&cases),
-                accumulation.summary(&cases)
-            )?;
+            let who = format!("`{}`, each user kind and axis", method.name());
+            writeln!(out, "- {}", accumulation.state_cases(&who, &cases))?;
             sequences(results, method, out);
         }
         writeln!(out)

@@ -179,11 +179,14 @@ fn ceiling_lines(results: &Results, grids: &[&[&RunRow]], out: &mut Out) -> fmt:
     Ok(())
 }
 
+/// What a sensitivity table groups the runs by.
+type Key<'a> = &'a dyn Fn(&RunRow) -> String;
+
 /// The tables by style, speed case and headway, into [`FILE`].
 fn sensitivity(results: &Results, user: &str, grids: &[&[&RunRow]], out: &mut Out) {
     let style = |r: &RunRow| r.spec.style_name().to_owned();
     let headway = |r: &RunRow| format!("{}", r.spec.headway_m);
-    let keys: [(&str, &dyn Fn(&RunRow) -> String); 3] = [
+    let keys: [(&str, Key); 3] = [
         ("style", &style),
         ("speed case", &speed_label),
         ("headway (m)", &headway),
