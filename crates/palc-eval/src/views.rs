@@ -138,6 +138,14 @@ impl<'a> Indexed<'a> {
         self.methods.get(method.name()).map_or(&[], Vec::as_slice)
     }
 
+    /// The experiments with runs, in the order of [`Experiment`]'s variants.
+    pub fn experiments(&self) -> Vec<Experiment> {
+        let mut experiments: Vec<Experiment> = self.experiments.keys().map(|(e, _)| *e).collect();
+        experiments.sort();
+        experiments.dedup();
+        experiments
+    }
+
     /// Whether any run belongs to `experiment`.
     pub fn has(&self, experiment: Experiment) -> bool {
         self.experiments.keys().any(|(e, _)| *e == experiment)

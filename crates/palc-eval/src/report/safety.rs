@@ -1,6 +1,7 @@
 //! REPORT.md's safety section: collisions, RSS safe-distance violations, the
 //! safety layer's refusals and the distributions of the smallest gaps and times to
-//! collision, per experiment and method, and palc's target of none
+//! collision, per experiment (every one with runs) and method, and palc's
+//! target of none
 //! (docs/experiments/0030-safety-measures-acc-and-gap-seeking.md,
 //! docs/experiments/0031-the-safety-layer-and-the-papers-scenes.md and
 //! docs/experiments/0032-the-safe-set-up-measured.md).
@@ -15,18 +16,6 @@ use crate::stats::percentile;
 use crate::targets::{TargetId, events_of, target};
 
 use super::section::{Out, Results, Section, fill, header};
-
-/// The experiments in the table's order.
-const EXPERIMENTS: [Experiment; 8] = [
-    Experiment::Grid,
-    Experiment::Transfer,
-    Experiment::Timing,
-    Experiment::ClosedLoop,
-    Experiment::Matrix,
-    Experiment::Accumulation,
-    Experiment::Ablation,
-    Experiment::AblationTransfer,
-];
 
 /// The safety section.
 pub struct Safety;
@@ -55,7 +44,8 @@ impl Section for Safety {
                 "min TTC, p5 / min (s)",
             ],
         )?;
-        for experiment in EXPERIMENTS {
+        // Every experiment with runs, a new one included, in the order of its variant.
+        for experiment in results.index.experiments() {
             for &method in results.methods() {
                 let rows = results.index.of_experiment(experiment, method);
                 let iterations: Vec<&Iteration> = rows.iter().flat_map(|r| &r.iterations).collect();
