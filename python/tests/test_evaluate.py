@@ -89,6 +89,8 @@ def test_evaluate_writes_the_report_and_read_runs_reads_it(tmp_path: Path) -> No
     first = rows[0]
     assert first["method"] == "palc" and first["style"] == "neutral"
     assert isinstance(first["takeovers"], int)
+    # A run id is 16 hex digits, kept a string even when it reads as a number.
+    assert isinstance(first["run_id"], str) and len(first["run_id"]) == 16
     assert calls[0] == (0, outcome["runs"]) and calls[-1] == (outcome["runs"], outcome["runs"])
     assert outcome["idle_experiments"] == []
 

@@ -1,5 +1,6 @@
-//! REPORT.md's "A drive of varied scenes" ([`crate::drive`]) and its figure: the
-//! takeover rate over a drive's lane changes, per method and user kind.
+//! The takeover rate over a drive's lane changes ([`crate::drive`]), per method
+//! and user kind: the table of REPORT.md's "A drive of varied scenes" (written by
+//! the report's drive section) and Fig. 16.
 //!
 //! A drive's lane changes are counted in driving order among the ones driven: a
 //! scene refused for the user (its standard ALC never starts, its start rule is
@@ -8,7 +9,6 @@
 //! the user would not have driven it.
 
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 
 use palc_harness::Method;
 
@@ -21,7 +21,7 @@ use crate::results::{RunRow, Status};
 pub const BANDS: [(usize, usize); 3] = [(1, 10), (11, 50), (51, 100)];
 
 /// The window of the figure's moving takeover rate (lane changes).
-const WINDOW: usize = 10;
+pub const WINDOW: usize = 10;
 
 /// One drive: its lane changes in driving order, `true` where taken over (or failed).
 type Drive = Vec<bool>;
@@ -130,63 +130,43 @@ pub fn drives(rows: &[RunRow], methods: &[Method], experiment: Experiment) -> Ve
     out
 }
 
-/// Writes the section; nothing without drive runs.
-pub fn section(out: &mut String, rows: &[RunRow], methods: &[Method]) {
+/// The table's lines, one per method and user kind of the drives in `rows`: the
+/// drives, scenes, driven, refused and failed lane changes and the takeover rate
+/// in each of [`BANDS`], beside the rate of the same lane changes from scratch.
+pub fn table_lines(rows: &[RunRow], methods: &[Method]) -> Vec<String> {
     let kinds = drives(rows, methods, Experiment::Drive);
     let scratch = drives(rows, methods, Experiment::DriveFromScratch);
-    if kinds.is_empty() {
-        return;
-    }
-    let _ = writeln!(out, "## A drive of varied scenes\n");
-    let _ = writeln!(
-        out,
-        "Each user kind drives a sequence of lane changes, one per scene and no scene twice (grid cells, each at most once, \
-         and scenes drawn around the grid: `[drive]` in the config), learning from every takeover throughout, once per style \
-         (a recorded kind: per driver). This is the takeover rate a driver would feel. A scene refused for the user is skipped \
-         and not counted; a lane change whose run failed counts as taken over. Rates are taken-over lane changes over the \
-         lane changes driven in each band (numbered among the driven ones), all drives of the kind together; \
-         beside each, the rate of the same lane changes driven without experience (every scene from scratch: \
-         the standard ALC's plan), which experience should never exceed.\n"
-    );
-    let header: Vec<String> = (BANDS.iter())
-        .map(|(a, b)| format!("lane changes {a}-{b}"))
-        .collect();
-    let _ = writeln!(
-        out,
-        "| method | user | drives | scenes | driven | refused | failed | {} |",
-        header.join(" | ")
-    );
-    let _ = writeln!(out, "|{}", " --- |".repeat(7 + BANDS.len()));
-    for kind in &kinds {
-        let baseline = (scratch.iter()).find(|s| s.method == kind.method && s.user == kind.user);
-        let rate = |(taken, n): (usize, usize)| 100.0 * taken as f64 / n as f64;
-        let bands: Vec<String> = (BANDS.iter())
-            .map(
-                |&band| match (kind.band(band), baseline.map(|b| b.band(band))) {
-                    ((_, 0), _) => "-".to_owned(),
-                    ((taken, n), Some(scratch)) if scratch.1 > 0 => format!(
-                        "{:.0} % ({taken}/{n}); from scratch {:.0} %",
-                        rate((taken, n)),
-                        rate(scratch)
-                    ),
-                    ((taken, n), _) => format!("{:.0} % ({taken}/{n})", rate((taken, n))),
-                },
+    let rate = |(taken, n): (usize, usize)| 100.0 * taken as f64 / n as f64;
+    (kinds.iter())
+        .map(|kind| {
+            let baseline =
+                (scratch.iter()).find(|s| s.method == kind.method && s.user == kind.user);
+            let bands: Vec<String> = (BANDS.iter())
+                .map(
+                    |&band| match (kind.band(band), baseline.map(|b| b.band(band))) {
+                        ((_, 0), _) => "-".to_owned(),
+                        ((taken, n), Some(scratch)) if scratch.1 > 0 => format!(
+                            "{:.0} % ({taken}/{n}); from scratch {:.0} %",
+                            rate((taken, n)),
+                            rate(scratch)
+                        ),
+                        ((taken, n), _) => format!("{:.0} % ({taken}/{n})", rate((taken, n))),
+                    },
+                )
+                .collect();
+            format!(
+                "| {} | {} | {} | {} | {} | {} | {} | {} |",
+                kind.method.name(),
+                kind.user,
+                kind.drives.len(),
+                kind.scenes,
+                kind.driven(),
+                kind.refused,
+                kind.failed,
+                bands.join(" | ")
             )
-            .collect();
-        let _ = writeln!(
-            out,
-            "| {} | {} | {} | {} | {} | {} | {} | {} |",
-            kind.method.name(),
-            kind.user,
-            kind.drives.len(),
-            kind.scenes,
-            kind.driven(),
-            kind.refused,
-            kind.failed,
-            bands.join(" | ")
-        );
-    }
-    let _ = writeln!(out);
+        })
+        .collect()
 }
 
 /// The figure of `method`'s drives: the moving takeover rate of each user kind,
@@ -304,21 +284,18 @@ mod tests {
     }
 
     #[test]
-    fn the_section_states_each_band_and_nothing_without_drives() {
-        let mut out = String::new();
-        section(&mut out, &[], &[Method::Palc]);
-        assert!(out.is_empty());
+    fn the_table_states_each_band_beside_the_rate_from_scratch() {
+        assert!(table_lines(&[], &[Method::Palc]).is_empty());
         let mut rows = drive("incentive", StylePreset::Aggressive, "T---------T", 0);
         let mut scratch = drive("incentive", StylePreset::Aggressive, "TTTTT-----T", 11);
         for row in &mut scratch {
             row.spec.experiment = Experiment::DriveFromScratch;
         }
         rows.extend(scratch);
-        section(&mut out, &rows, &[Method::Paper, Method::Palc]);
-        assert!(out.contains("## A drive of varied scenes"), "{out}");
+        let lines = table_lines(&rows, &[Method::Paper, Method::Palc]);
         let line = "| palc | incentive | 1 | 11 | 11 | 0 | 0 | 10 % (1/10); from scratch 50 % | \
                     100 % (1/1); from scratch 100 % | - |";
-        assert!(out.contains(line), "{out}");
+        assert_eq!(lines, [line]);
         assert_eq!(figures(&rows, Method::Palc, 6).len(), 1);
         assert!(figures(&rows, Method::Paper, 6).is_empty());
     }

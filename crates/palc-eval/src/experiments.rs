@@ -9,8 +9,8 @@ use crate::figures::{self, Bars, Example, Lines};
 use crate::harness_runs::ExampleTrace;
 use crate::plan::Experiment;
 use crate::results::RunRow;
+use crate::scenes::{Axis, accumulation_places, matrix_pairs};
 use crate::stats;
-use crate::transfer_report::{Axis, accumulation_places, matrix_pairs};
 use crate::views::{FigureFile, grid, slug, speed_label, timing, with_transfer};
 
 /// Series of a bar chart: name and one value per category.

@@ -7,8 +7,9 @@
 //! embedder can run any evaluation config from Rust the same way, or take the
 //! pieces: [`Evaluation::load`] reads and checks the configs, [`Evaluation::plan`]
 //! expands them into runs, [`runner::execute`] runs them through the harness
-//! ([`HarnessRuns`]) on a fixed number of threads, and [`stats`], [`claims`] and
-//! [`report`] turn the rows into numbers and text.
+//! ([`HarnessRuns`]) on a fixed number of threads, and [`stats`], [`claims`],
+//! [`targets`] and [`report`] turn the rows into numbers and text. Every run is
+//! named in the outputs by a [`run_id`], a hash of what it runs.
 //!
 //! ```no_run
 //! use palc_eval::{EvalOptions, NoProgress, evaluate};
@@ -31,16 +32,13 @@
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod ablation;
-pub mod ablation_report;
 pub mod claims;
-pub mod closed_loop_report;
 pub mod config;
 pub mod drive;
 pub mod drive_report;
 mod error;
 #[cfg(feature = "plot")]
 mod experiments;
-pub mod families_report;
 #[cfg(feature = "plot")]
 pub mod figures;
 pub mod harness_runs;
@@ -48,15 +46,14 @@ pub mod idle;
 pub mod manifest;
 pub mod plan;
 pub mod recorded_drivers;
-pub mod recorded_report;
 pub mod report;
 pub mod results;
+pub mod run_id;
 pub mod runner;
-pub mod safety_report;
+pub mod scenes;
 pub mod shard;
 pub mod stats;
-pub mod timing_report;
-pub mod transfer_report;
+pub mod targets;
 pub mod views;
 
 use std::path::{Path, PathBuf};
@@ -408,7 +405,7 @@ fn write_results(
     )?;
     #[cfg(not(feature = "plot"))]
     let figures = Vec::new();
-    let report_text = report::render(&report::ReportInput {
+    let report = report::render(&report::ReportInput {
         rows: &rows,
         methods: &selection.grid.methods,
         users: &user_names,
@@ -420,10 +417,16 @@ fn write_results(
         recorded: evaluation.harness.recorded(),
         idle: &idle,
     });
-    write(&out.join("REPORT.md"), &report_text)?;
-    // The example's files of an earlier run are not carried over when this one has
-    // none.
-    staging.commit(&["example.json", "fig06-example.svg", "fig06-example.png"])?;
+    write(&out.join("REPORT.md"), &report.text)?;
+    for table in &report.tables {
+        let rows = table.rows.iter();
+        results::write_csv(&out.join(table.file), Some(table.header), rows)?;
+    }
+    // The example's files and the report's tables of an earlier run are not carried
+    // over when this one has none.
+    let mut obsolete = vec!["example.json", "fig06-example.svg", "fig06-example.png"];
+    obsolete.extend(report::TABLE_FILES);
+    staging.commit(&obsolete)?;
     let report = out_dir.join("REPORT.md");
     Ok(Outcome {
         report,

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::EvalError;
 use crate::plan::RunSpec;
+use crate::run_id::run_ids;
 
 /// How a run ended, as the report counts it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -239,8 +240,9 @@ impl RunRow {
 }
 
 /// The columns of `refusals.csv`, in the order of [`RefusalCsvRow`]'s fields.
-const REFUSAL_COLUMNS: [&str; 10] = [
+const REFUSAL_COLUMNS: [&str; 11] = [
     "id",
+    "run_id",
     "experiment",
     "method",
     "user",
@@ -256,6 +258,7 @@ const REFUSAL_COLUMNS: [&str; 10] = [
 #[derive(Debug, Serialize)]
 struct RefusalCsvRow<'a> {
     id: usize,
+    run_id: &'a str,
     experiment: &'a str,
     method: &'a str,
     user: &'a str,
@@ -270,12 +273,14 @@ struct RefusalCsvRow<'a> {
 /// Writes `refusals.csv`: one line per refused run, with its kind and message
 /// (REPORT.md counts them by kind and experiment); the header also without any.
 pub fn write_refusals(rows: &[RunRow], path: &Path) -> Result<(), EvalError> {
-    let lines = rows.iter().filter_map(|row| {
+    let ids = run_ids(rows.iter().map(|r| &r.spec));
+    let lines = rows.iter().zip(&ids).filter_map(|(row, run_id)| {
         let Status::Refused { reason, .. } = &row.status else {
             return None;
         };
         Some(RefusalCsvRow {
             id: row.spec.id,
+            run_id,
             experiment: row.spec.experiment.name(),
             method: row.spec.method.name(),
             user: &row.spec.user.name,
@@ -293,7 +298,7 @@ pub fn write_refusals(rows: &[RunRow], path: &Path) -> Result<(), EvalError> {
 /// Writes `lines` as CSV to `path` through the atomic writer, under `header`
 /// when given (kept when there are no lines), else under the header serde
 /// derives from the first line.
-fn write_csv<T: Serialize>(
+pub(crate) fn write_csv<T: Serialize>(
     path: &Path,
     header: Option<&[&str]>,
     lines: impl IntoIterator<Item = T>,
@@ -318,6 +323,7 @@ fn write_csv<T: Serialize>(
 #[derive(Debug, Serialize)]
 struct CsvRow<'a> {
     id: usize,
+    run_id: &'a str,
     experiment: &'a str,
     method: &'a str,
     user: &'a str,
@@ -352,11 +358,24 @@ struct CsvRow<'a> {
     note: String,
 }
 
-/// Writes `runs.json` (every field) and `runs.csv` (one line per run).
+/// One run of `runs.json`: its id ([`crate::run_id`]) and every field of the row.
+#[derive(Debug, Serialize)]
+struct JsonRow<'a> {
+    run_id: &'a str,
+    #[serde(flatten)]
+    row: &'a RunRow,
+}
+
+/// Writes `runs.json` (every field) and `runs.csv` (one line per run), each
+/// run with its id ([`crate::run_id`]).
 pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> Result<(), EvalError> {
-    let text = serde_json::to_string_pretty(rows)?;
+    let ids = run_ids(rows.iter().map(|r| &r.spec));
+    let json_rows: Vec<JsonRow> = (rows.iter().zip(&ids))
+        .map(|(row, run_id)| JsonRow { run_id, row })
+        .collect();
+    let text = serde_json::to_string_pretty(&json_rows)?;
     palc_aggregator::output::write(json, text.as_bytes())?;
-    let lines = rows.iter().map(|row| {
+    let lines = rows.iter().zip(&ids).map(|(row, run_id)| {
         let note = match &row.status {
             Status::Refused { reason, .. } => reason.clone(),
             Status::Failed { error } => error.clone(),
@@ -364,6 +383,7 @@ pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> Result<(), EvalEr
         };
         CsvRow {
             id: row.spec.id,
+            run_id,
             experiment: row.spec.experiment.name(),
             method: row.spec.method.name(),
             user: &row.spec.user.name,
@@ -417,6 +437,7 @@ mod tests {
         assert_eq!(text.lines().count(), rows.len() + 1);
         let header = text.lines().next().unwrap();
         for column in [
+            "run_id",
             "method",
             "user",
             "style",
@@ -431,6 +452,9 @@ mod tests {
             serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
         assert_eq!(back.len(), rows.len());
         assert_eq!(back[0].spec, rows[0].spec);
+        let ids: Vec<serde_json::Value> =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        assert_eq!(ids[0]["run_id"], run_ids(rows.iter().map(|r| &r.spec))[0]);
         std::fs::remove_dir_all(&dir).unwrap();
     }
 
@@ -447,7 +471,7 @@ mod tests {
         let mut lines = text.lines();
         assert_eq!(
             lines.next(),
-            Some("id,experiment,method,user,style,speed_case,headway_m,seed,kind,reason")
+            Some("id,run_id,experiment,method,user,style,speed_case,headway_m,seed,kind,reason")
         );
         assert_eq!(lines.count(), refused.len());
         for row in &refused {
