@@ -162,6 +162,20 @@ impl UserKind {
         self.family.is_some() || self.spread_parameters.is_some() || self.recorded.is_some()
     }
 
+    /// Whether the kind's decision to start is outside the one-cue rules palc's
+    /// simulated users were built around: a recorded driver, or a family that
+    /// starts on MOBIL's incentive or on two cues at once.
+    pub fn is_out_of_class(&self) -> bool {
+        self.recorded.is_some()
+            || (self.family.as_ref()).is_some_and(|f| {
+                matches!(
+                    f.start,
+                    palc_harness::user::StartRule::Incentive { .. }
+                        | palc_harness::user::StartRule::HeadwayOrTtc { .. }
+                )
+            })
+    }
+
     /// Whether the kind has a family or spread of its own (besides recorded drivers).
     fn is_family_of_its_own(&self) -> bool {
         self.family.is_some() || self.has_spread()

@@ -7,6 +7,7 @@ use std::fmt::{self, Write as _};
 use super::section::{Out, Results, Section, fill, header};
 use crate::drive_report::{BANDS, WINDOW, table_lines};
 use crate::plan::Experiment;
+use crate::targets::{TargetId, Verdict, target};
 
 /// The drive section.
 pub struct Drive;
@@ -36,6 +37,18 @@ impl Section for Drive {
         header(out, &columns)?;
         for line in table_lines(results.input.rows, results.methods()) {
             writeln!(out, "{line}")?;
+        }
+        writeln!(out)?;
+        for id in [TargetId::DriveOwnFamilies, TargetId::DriveOutOfClass] {
+            let target = target(id);
+            for &method in results.methods() {
+                let cases = target.cases(&results.index, method, results.input.user_kinds);
+                if target.judge(&cases) == Verdict::NotMeasured {
+                    continue;
+                }
+                let who = format!("`{}`, each user kind", method.name());
+                writeln!(out, "- {}", target.state_cases(&who, &cases))?;
+            }
         }
         writeln!(out)
     }

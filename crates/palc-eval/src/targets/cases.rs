@@ -87,8 +87,31 @@ impl Target {
                     .collect();
                 stats::timing_of(&learning).map_or_else(Vec::new, |t| whole(Measured::Timing(t)))
             }
+            TargetId::DriveOwnFamilies => drive(index, method, kinds, |k| {
+                !k.has_spread() && !k.is_out_of_class()
+            }),
+            TargetId::DriveOutOfClass => drive(index, method, kinds, UserKind::is_out_of_class),
         }
     }
+}
+
+/// The drive's lane changes 11-50 of `method`, per user kind of `kinds` that
+/// `includes` and that drove any of them.
+fn drive(
+    index: &Indexed,
+    method: Method,
+    kinds: &[UserKind],
+    includes: impl Fn(&UserKind) -> bool,
+) -> Vec<Case> {
+    let drives = crate::drive_report::drives(index.rows(), &[method], Experiment::Drive);
+    (kinds.iter())
+        .filter(|kind| includes(kind))
+        .filter_map(|kind| {
+            let drive = drives.iter().find(|d| d.user == kind.name)?;
+            let (taken, driven) = drive.band(crate::drive_report::BANDS[1]);
+            (driven > 0).then(|| case(kind, Measured::TakenOver { taken, driven }))
+        })
+        .collect()
 }
 
 /// A case of one user kind.

@@ -52,6 +52,10 @@ pub enum TargetId {
     Safety,
     /// A learning iteration's compute time.
     LearningTime,
+    /// A drive of varied scenes, palc's deterministic families.
+    DriveOwnFamilies,
+    /// A drive of varied scenes, drivers outside the one-cue rules.
+    DriveOutOfClass,
 }
 
 /// How a measurement is judged.
@@ -74,6 +78,8 @@ pub enum Rule {
         /// Largest gap in mean takeovers.
         takeovers: f64,
     },
+    /// At most this share of a drive's lane changes 11-50 taken over.
+    AtMostTakenOver(f64),
     /// Not one event.
     NoEvent,
     /// Mean and 95th percentile below these (s).
@@ -156,6 +162,22 @@ pub const TARGETS: &[Target] = &[
         },
         source: "docs/experiments/0018-compute-time.md",
     },
+    Target {
+        id: TargetId::DriveOwnFamilies,
+        name: "a drive of varied scenes, palc's deterministic families",
+        how: "taken-over lane changes over those driven, lane changes 11-50 of every drive, per user kind without spread \
+              whose decision is a threshold on one cue",
+        rule: Rule::AtMostTakenOver(0.10),
+        source: "docs/experiments/0073-a-drive-of-varied-scenes.md",
+    },
+    Target {
+        id: TargetId::DriveOutOfClass,
+        name: "a drive of varied scenes, drivers outside the one-cue rules",
+        how: "taken-over lane changes over those driven, lane changes 11-50 of every drive, per recorded user kind and per kind \
+              that starts on MOBIL's incentive or on two cues",
+        rule: Rule::AtMostTakenOver(0.20),
+        source: "docs/experiments/0073-a-drive-of-varied-scenes.md",
+    },
 ];
 
 /// The target with `id`.
@@ -191,6 +213,13 @@ pub enum Measured {
     Events(Events),
     /// Compute times.
     Timing(Timing),
+    /// Lane changes taken over, of the lane changes driven.
+    TakenOver {
+        /// Taken over (or failed).
+        taken: usize,
+        /// Driven.
+        driven: usize,
+    },
 }
 
 /// Pairs of a transfer: a cell from scratch and with experience, both counted.
@@ -293,6 +322,10 @@ impl Rule {
             Rule::LikeOpenLoop { points, takeovers } => format!(
                 "success within {points} points and mean takeovers within {takeovers} of open loop"
             ),
+            Rule::AtMostTakenOver(share) => format!(
+                "at most {:.0} % of lane changes 11-50 taken over",
+                100.0 * share
+            ),
             Rule::NoEvent => "none in any executed lane change".to_owned(),
             Rule::Faster { mean_s, p95_s } => format!(
                 "below {:.0} ms in the mean and {:.0} ms at the 95th percentile",
@@ -323,6 +356,11 @@ impl Target {
                     takeovers: t,
                 },
             ) => (success.0 - success.1).abs() <= points && (t.0 - t.1).abs() <= takeovers,
+            (Rule::AtMostTakenOver(share), Measured::TakenOver { taken, driven })
+                if *driven > 0 =>
+            {
+                *taken as f64 <= share * *driven as f64 + SHARE_TOLERANCE
+            }
             (Rule::NoEvent, Measured::Events(e)) => *e == Events::default(),
             (Rule::Faster { mean_s, p95_s }, Measured::Timing(t)) => {
                 t.mean < mean_s && t.p95 < p95_s
@@ -365,6 +403,10 @@ impl Target {
                 t.p95 * 1e3,
                 t.iterations
             ),
+            Measured::TakenOver { taken, driven } => {
+                let share = (*driven > 0).then(|| *taken as f64 / *driven as f64);
+                format!("{taken}/{driven} ({})", crate::claims::pct(share))
+            }
         }
     }
 
