@@ -418,6 +418,13 @@ pub(crate) fn predicted_start_s(setup: &Setup, onsets: &[Onset], duration_s: f64
         .reduce(f64::min)
         .unwrap_or(f64::INFINITY);
     let assumed = assumed_lead_gap_s(setup, accepted);
+    // A refused gap is read through the learned threshold (the user had decided,
+    // so only the leader can have held it back), an accepted one is seen: a
+    // driver who accepted a gap does not need a larger one, so a refused gap
+    // above an accepted one was a misreading (the decision came later than the
+    // threshold said) and bounds the need by the accepted gap at most
+    // (docs/experiments/0073-a-drive-of-varied-scenes.md).
+    let refused = refused.min(accepted);
     let lead = (acceptance(onsets, |o| o.lead_time_gap_s).max(refused)).max(assumed);
     let lag = acceptance(onsets, |o| o.lag_time_gap_s);
     let situations = &setup.situations;
@@ -530,6 +537,36 @@ mod tests {
             follower_wait_time_headway_s: None,
             observations: 1,
             scene: None,
+        }
+    }
+
+    #[test]
+    fn a_refused_lead_gap_above_an_accepted_one_asks_no_more_than_the_accepted_one() {
+        let text = include_str!("../../../../configs/learn.toml");
+        let config = crate::config::LearnConfig::from_toml_str(text).unwrap();
+        let setup = crate::scenario::prepare(&config).unwrap();
+        // The lead gaps this scene offers over its steps: a refused gap between
+        // two of them moves the start when it is the need, and must not here.
+        let gaps: Vec<f64> = setup.situations.iter().filter_map(lead_time_gap).collect();
+        let low = gaps
+            .iter()
+            .copied()
+            .filter(|g| *g > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        let high = gaps.iter().copied().fold(0.0, f64::max);
+        assert!(low < high, "the scene's lead gaps vary: {low} to {high}");
+        let accepted = low;
+        let mut seen = onset(1.2, 10.0, None);
+        seen.accepted_lead_time_gap_s = Some(accepted);
+        let with_refused = |refused: f64| {
+            let mut refusing = onset(1.2, 10.0, None);
+            refusing.rejected_lead_time_gap_s = Some(refused);
+            predicted_start_s(&setup, &[seen.clone(), refusing], 2.0)
+        };
+        let at_accepted = with_refused(accepted);
+        assert!(at_accepted.is_some());
+        for refused in [0.5 * (accepted + high), high, 10.0 * high] {
+            assert_eq!(with_refused(refused), at_accepted, "refused {refused} s");
         }
     }
 
