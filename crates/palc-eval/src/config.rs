@@ -341,7 +341,7 @@ impl EvalConfig {
             let drive = Drive {
                 users: self.drive.users.clone(),
                 methods: (self.drive.methods.clone()).unwrap_or_else(|| grid.methods.clone()),
-                scenes: self.drive.scenes("drive", &grid)?,
+                scenes: self.drive.scenes("drive", grid.cells_to_draw())?,
             };
             return Ok(Selection {
                 grid,
@@ -374,7 +374,10 @@ impl EvalConfig {
         let drive = Drive {
             users: self.quick.drive.users.clone(),
             methods: (self.quick.drive.methods.clone()).unwrap_or_else(|| grid.methods.clone()),
-            scenes: self.quick.drive.scenes("quick.drive", &grid)?,
+            scenes: self
+                .quick
+                .drive
+                .scenes("quick.drive", grid.cells_to_draw())?,
         };
         Ok(Selection {
             grid,
@@ -576,6 +579,15 @@ impl GridConfig {
 }
 
 impl Grid {
+    /// The cells a drive is drawn around.
+    pub fn cells_to_draw(&self) -> crate::drive::GridCells<'_> {
+        crate::drive::GridCells {
+            speed_cases: &self.speed_cases,
+            headways_m: &self.headways_m,
+            seeds: &self.seeds,
+        }
+    }
+
     /// Number of cells per method and user.
     pub fn cells(&self) -> usize {
         self.speed_cases.len() * self.headways_m.len() * self.styles.len() * self.seeds.len()

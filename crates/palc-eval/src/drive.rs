@@ -26,7 +26,6 @@ use serde::{Deserialize, Serialize};
 use palc_harness::Method;
 
 use crate::EvalError;
-use crate::config::Grid;
 
 /// The lane changes of a drive when the config leaves them out.
 pub const DEFAULT_LANE_CHANGES: usize = 100;
@@ -82,6 +81,17 @@ pub struct DriveConfig {
     /// (and at least 15) when left out.
     #[serde(default)]
     pub headway_m: Option<[f64; 2]>,
+}
+
+/// The cells of the grid a drive is drawn around: its speed cases, headways and seeds.
+#[derive(Debug, Clone, Copy)]
+pub struct GridCells<'a> {
+    /// The grid's speed cases.
+    pub speed_cases: &'a [SpeedCaseConfig],
+    /// The grid's headways (m).
+    pub headways_m: &'a [f64],
+    /// The grid's scene seeds.
+    pub seeds: &'a [u64],
 }
 
 /// One scene of a drive.
@@ -157,7 +167,7 @@ impl DriveConfig {
     /// # Errors
     /// [`EvalError::InvalidConfig`] when a drawn scene's other vehicles would not
     /// move (the ego's speed at most the speed difference).
-    pub fn scenes(&self, table: &str, grid: &Grid) -> Result<Vec<DriveScene>, EvalError> {
+    pub fn scenes(&self, table: &str, grid: GridCells<'_>) -> Result<Vec<DriveScene>, EvalError> {
         let mut rng = ChaCha8Rng::seed_from_u64(self.seed);
         let (ego, difference, headway) = self.ranges(grid);
         if ego[0] <= difference[1] {
@@ -218,7 +228,7 @@ impl DriveConfig {
     }
 
     /// The drawn scenes' ranges: the config's, or the grid's widened by one step.
-    fn ranges(&self, grid: &Grid) -> ([f64; 2], [f64; 2], [f64; 2]) {
+    fn ranges(&self, grid: GridCells<'_>) -> ([f64; 2], [f64; 2], [f64; 2]) {
         let span = |values: &mut dyn Iterator<Item = f64>| {
             values.fold([f64::INFINITY, f64::NEG_INFINITY], |[lo, hi], v| {
                 [lo.min(v), hi.max(v)]
@@ -250,12 +260,12 @@ fn round(x: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use palc_harness::StylePreset;
 
-    fn grid() -> Grid {
-        Grid {
-            methods: vec![Method::Palc],
-            speed_cases: vec![
+    /// Two speed cases, two headways, two seeds.
+    fn grid() -> GridCells<'static> {
+        static CASES: std::sync::OnceLock<Vec<SpeedCaseConfig>> = std::sync::OnceLock::new();
+        let cases = CASES.get_or_init(|| {
+            vec![
                 SpeedCaseConfig {
                     name: "collector-high".into(),
                     ego_mph: 45.0,
@@ -266,10 +276,12 @@ mod tests {
                     ego_mph: 65.0,
                     others_mph: 55.0,
                 },
-            ],
-            headways_m: vec![50.0, 30.0],
-            styles: vec![StylePreset::Neutral],
-            seeds: vec![1, 2],
+            ]
+        });
+        GridCells {
+            speed_cases: cases,
+            headways_m: &[50.0, 30.0],
+            seeds: &[1, 2],
         }
     }
 
@@ -281,18 +293,18 @@ mod tests {
             seed: 7,
             ..DriveConfig::default()
         };
-        let scenes = config.scenes("drive", &grid()).unwrap();
+        let scenes = config.scenes("drive", grid()).unwrap();
         assert_eq!(scenes.len(), 400);
         assert_eq!(
             scenes,
-            config.scenes("drive", &grid()).unwrap(),
+            config.scenes("drive", grid()).unwrap(),
             "one seed, one drive"
         );
         let other = DriveConfig {
             seed: 8,
             ..config.clone()
         };
-        assert_ne!(scenes, other.scenes("drive", &grid()).unwrap());
+        assert_ne!(scenes, other.scenes("drive", grid()).unwrap());
         // Every grid cell once (2 cases x 2 headways x 2 seeds), no scene twice.
         let on_grid = scenes.iter().filter(|s| s.seed <= 2).count();
         assert_eq!(on_grid, 8);
@@ -320,8 +332,8 @@ mod tests {
             grid_share: Some(1.0),
             ..all_drawn.clone()
         };
-        let drawn = all_drawn.scenes("drive", &grid()).unwrap();
-        let cells = all_grid.scenes("drive", &grid()).unwrap();
+        let drawn = all_drawn.scenes("drive", grid()).unwrap();
+        let cells = all_grid.scenes("drive", grid()).unwrap();
         let is_drawn = |s: &DriveScene| s.speed_case.name.starts_with("drawn-");
         assert!(drawn.iter().all(is_drawn));
         // The eight cells first, then, used up, drawn scenes: the same as without cells.
@@ -331,7 +343,7 @@ mod tests {
             grid_share: Some(0.5),
             ..all_drawn.clone()
         };
-        for (i, scene) in half.scenes("drive", &grid()).unwrap().iter().enumerate() {
+        for (i, scene) in half.scenes("drive", grid()).unwrap().iter().enumerate() {
             assert!(
                 scene == &drawn[i] || cells[..8].contains(scene),
                 "scene {i}: {scene:?}"
@@ -381,7 +393,7 @@ mod tests {
             ..DriveConfig::default()
         };
         slow.validate("drive").unwrap();
-        let error = slow.scenes("drive", &grid()).unwrap_err().to_string();
+        let error = slow.scenes("drive", grid()).unwrap_err().to_string();
         assert!(error.contains("drive.ego_mph"), "{error}");
     }
 }

@@ -477,7 +477,7 @@ pub(crate) mod tests {
             grid_share: Some(1.0),
             ..Default::default()
         };
-        let mut scenes = config.scenes("drive", &grid).unwrap();
+        let mut scenes = config.scenes("drive", grid.cells_to_draw()).unwrap();
         // Seeds: refused (odd), refused, driven, refused, driven, driven.
         for (scene, seed) in scenes.iter_mut().zip([1, 3, 2, 5, 4, 6]) {
             scene.seed = seed;
