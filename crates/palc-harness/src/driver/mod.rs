@@ -23,7 +23,7 @@
 //! to carry a start for a driver outside the model) cost more takeovers on the
 //! evaluation's grid (docs/experiments/0068-one-driver-model.md). For a driver
 //! whose decision the estimate places on a cue the readings do not read (MOBIL's
-//! incentive), the estimate predicts ([`start_beyond_readings`],
+//! incentive), the estimate predicts (`start_beyond_readings`,
 //! docs/experiments/0073-a-drive-of-varied-scenes.md).
 
 mod estimate;
