@@ -12,6 +12,7 @@ use std::collections::BTreeMap;
 
 use palc_harness::Method;
 
+#[cfg(feature = "plot")]
 use crate::figures::Lines;
 use crate::plan::Experiment;
 use crate::results::{RunRow, Status};
@@ -169,6 +170,7 @@ pub fn table_lines(rows: &[RunRow], methods: &[Method]) -> Vec<String> {
         .collect()
 }
 
+#[cfg(feature = "plot")]
 /// The figure of `method`'s drives: the moving takeover rate of each user kind,
 /// in groups of at most `per_figure` kinds (one figure each); none without drives.
 pub fn figures(rows: &[RunRow], method: Method, per_figure: usize) -> Vec<Lines> {
@@ -296,6 +298,12 @@ mod tests {
         let line = "| palc | incentive | 1 | 11 | 11 | 0 | 0 | 10 % (1/10); from scratch 50 % | \
                     100 % (1/1); from scratch 100 % | - |";
         assert_eq!(lines, [line]);
+    }
+
+    #[cfg(feature = "plot")]
+    #[test]
+    fn a_figure_per_method_that_drove() {
+        let rows = drive("incentive", StylePreset::Aggressive, "T---------T", 0);
         assert_eq!(figures(&rows, Method::Palc, 6).len(), 1);
         assert!(figures(&rows, Method::Paper, 6).is_empty());
     }
