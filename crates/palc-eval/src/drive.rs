@@ -48,7 +48,7 @@ const MIN_DIFFERENCE_MPH: f64 = 1.0;
 /// The smallest drawn headway (m): below it the target lane's vehicles overlap.
 const MIN_HEADWAY_M: f64 = 15.0;
 
-/// The first seed of a drawn scene: above every seed a grid of the test bed uses,
+/// The seeds of drawn scenes: above every seed the test bed's grids use (1-4),
 /// so a drawn scene's traffic is never a grid cell's.
 const DRAWN_SEEDS: std::ops::RangeInclusive<u64> = 1_000..=1_000_000;
 
