@@ -142,12 +142,12 @@ pub fn execute<E: Executor>(
                             let (row, learned) = executor.run(spec, Some(experience));
                             (row, learned.or_else(|| passed_on(spec, experience)))
                         }
+                        (None, _) => executor.run(spec, None),
                         // A drive that has learned nothing yet (its first
                         // scenes were refused) starts from scratch.
-                        (None, _) | (Some(_), None) if spec.experiment == Experiment::Drive => {
+                        (Some(_), None) if spec.experiment == Experiment::Drive => {
                             executor.run(spec, None)
                         }
-                        (None, _) => executor.run(spec, None),
                         (Some(source), None) => {
                             let from = (match source.checked_sub(offset) {
                                 None => rows.get(source),
