@@ -280,6 +280,7 @@ fn row(spec: &RunSpec, result: &RunResult, iterations: Vec<Iteration>, wall_s: f
         dt: Some(result.dt),
         wall_s,
         iterations,
+        driver_belief: result.carried_belief,
     }
 }
 

@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use crate::EvalError;
 use crate::plan::RunSpec;
 use crate::run_id::run_ids;
+use palc_harness::driver::CarriedBelief;
 
 /// How a run ended, as the report counts it.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -168,6 +169,10 @@ pub struct RunRow {
     pub wall_s: f64,
     /// Every lane change.
     pub iterations: Vec<Iteration>,
+    /// What the driver estimate believed when this run's experience was carried
+    /// in (two recorded scenes or more, `palc`'s relative space).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub driver_belief: Option<CarriedBelief>,
 }
 
 impl RunRow {
@@ -188,6 +193,7 @@ impl RunRow {
             dt: None,
             wall_s,
             iterations: Vec::new(),
+            driver_belief: None,
         }
     }
 
@@ -355,6 +361,8 @@ struct CsvRow<'a> {
     min_gap_target_lead_m: Option<f64>,
     min_gap_target_lag_m: Option<f64>,
     min_ttc_s: Option<f64>,
+    estimate_cue: Option<&'static str>,
+    estimate_outside_model: Option<bool>,
     note: String,
 }
 
@@ -415,6 +423,8 @@ pub fn write(rows: &[RunRow], json: &Path, csv_path: &Path) -> Result<(), EvalEr
             min_gap_target_lead_m: row.min_of(|s| s.min_gap_target_lead_m),
             min_gap_target_lag_m: row.min_of(|s| s.min_gap_target_lag_m),
             min_ttc_s: row.min_of(SafetyMetrics::min_ttc_s),
+            estimate_cue: row.driver_belief.map(|b| b.cue.name()),
+            estimate_outside_model: row.driver_belief.map(|b| b.outside_model),
             note,
         }
     });

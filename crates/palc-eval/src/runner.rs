@@ -311,6 +311,7 @@ pub(crate) mod tests {
                 dt: Some(dt),
                 wall_s: 0.01,
                 iterations,
+                driver_belief: None,
             };
             (row, Some(spec.id))
         }

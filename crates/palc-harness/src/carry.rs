@@ -10,7 +10,7 @@ use palc_aggregator::{
 use palc_planner::{Planner, Problem, State, Weights};
 
 use crate::HarnessError;
-use crate::driver::start_beyond_readings;
+use crate::driver::{CarriedBelief, start_beyond_readings};
 use crate::lesson::scenes;
 use crate::onset::{UserLaneChange, predicted_start_s};
 use crate::setup::Setup;
@@ -24,6 +24,18 @@ pub struct Names<'a> {
     pub scenario: &'a str,
     /// The method's name.
     pub method: &'a str,
+}
+
+/// An experience carried into a scene ([`starting_experience`]).
+#[derive(Debug, Clone)]
+pub struct Carried {
+    /// The experience the run starts from.
+    pub experience: Experience,
+    /// The user's path to rehearse in this scene, if any.
+    pub rehearsal: Option<Vec<f64>>,
+    /// What the driver estimate believed when it was consulted (relative space,
+    /// two recorded scenes or more).
+    pub belief: Option<CarriedBelief>,
 }
 
 /// The experience a run starts from: `previous` carried into this scenario, or a
@@ -47,7 +59,7 @@ pub(crate) fn starting_experience(
     setup: &Setup,
     previous: Option<&Experience>,
     relative: bool,
-) -> Result<(Experience, Option<Vec<f64>>), HarnessError> {
+) -> Result<Carried, HarnessError> {
     let (k, dt) = (setup.horizon, setup.dt);
     let Some(previous) = previous else {
         let fresh = Experience::new(
@@ -57,11 +69,16 @@ pub(crate) fn starting_experience(
             standard_weights.clone(),
             dt,
         )?;
-        return Ok((fresh, None));
+        return Ok(Carried {
+            experience: fresh,
+            rehearsal: None,
+            belief: None,
+        });
     };
     let mut carried = previous.clone();
     carried.metadata.dt = dt;
     names.scenario.clone_into(&mut carried.metadata.scenario);
+    let mut belief = None;
     let anchored = match (relative, previous.anchor_s) {
         (true, Some(anchor)) => {
             let settled = settled_duration_s(setup, previous, anchor);
@@ -72,7 +89,9 @@ pub(crate) fn starting_experience(
             let lane_change = (previous.demonstration.as_deref())
                 .and_then(|path| UserLaneChange::fit(path, 0, previous.metadata.dt, setup.target_l))
                 .map_or(settled, |fitted| fitted.duration_s.max(settled));
-            (start_beyond_readings(setup, &previous.onsets, lane_change))
+            let estimated = start_beyond_readings(setup, &previous.onsets, lane_change);
+            belief = estimated.belief;
+            (estimated.start_s)
                 .or_else(|| predicted_start_s(setup, &previous.onsets, lane_change))
                 .map(|start| (anchor, start.min(latest)))
         }
@@ -81,7 +100,11 @@ pub(crate) fn starting_experience(
     let Some((anchor, start)) = anchored else {
         carried.weights = previous.weights_for(k, dt)?;
         carried.demonstration = None;
-        return Ok((carried, None));
+        return Ok(Carried {
+            experience: carried,
+            rehearsal: None,
+            belief,
+        });
     };
     let shift = start - anchor;
     let from_dt = previous.metadata.dt;
@@ -91,7 +114,11 @@ pub(crate) fn starting_experience(
         .filter(|path| !path.is_empty())
         .map(|path| shifted_path(path, from_dt, k, dt, shift));
     carried.demonstration.clone_from(&path);
-    Ok((carried, path))
+    Ok(Carried {
+        experience: carried,
+        rehearsal: path,
+        belief,
+    })
 }
 
 /// The latest start (s) a carried lane change is anchored at: the one whose lane

@@ -66,7 +66,7 @@ pub use config::{CellChoice, LearnConfig, UserConfig};
 pub use error::HarnessError;
 pub use learning_loop::{LearningLoop, run};
 pub use method::Method;
-pub use observer::{LessonEvent, NoObserver, Observer};
+pub use observer::{DriverEvidence, LessonEvent, NoObserver, Observer};
 pub use palc_user::{StylePreset, User, UserScene};
 pub use record::{LaneChangeRecord, Outcome, RunResult, RunSummary};
 pub use refusal::Refusal;
@@ -80,7 +80,7 @@ pub use world::{PalcTraffic, World, WorldError};
 /// [`LearningLoop`] composes them; most embedders need only that.
 pub mod advanced {
     pub use crate::acc::acc_leader;
-    pub use crate::carry::Names;
+    pub use crate::carry::{Carried, Names};
     pub use crate::drive::{Drive, execute, execute_in, judge, plan_safety, problem};
     pub use crate::method::{Driver, label};
     pub use crate::personalization::{

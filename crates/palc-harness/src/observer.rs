@@ -2,7 +2,9 @@
 //! evaluation's traces): every lane change, what each lesson produced, and the
 //! summary at the end. The loop knows them only through [`Observer`].
 
-use palc_aggregator::{AggregatorError, Lesson, StepOutcome};
+use palc_aggregator::{AggregatorError, Lesson, Onset, StepOutcome};
+
+use crate::driver::DriverEstimate;
 
 use crate::record::{LaneChangeRecord, RunSummary};
 use crate::safety::Violation;
@@ -21,6 +23,8 @@ pub enum LessonEvent<'a> {
         lesson: &'a Lesson,
         /// What the learning step produced.
         outcome: &'a StepOutcome,
+        /// What the experience now knows of the driver's start, this lesson's included.
+        driver: DriverEvidence<'a>,
     },
     /// The method could not learn from the lesson (e.g. the paper's zone-centre
     /// expert infeasible in a hard zone); the experience stays as it was and the
@@ -32,7 +36,30 @@ pub enum LessonEvent<'a> {
         lesson: &'a Lesson,
         /// Why the learning step failed.
         error: &'a AggregatorError,
+        /// What the experience knows of the driver's start (unchanged by this lesson).
+        driver: DriverEvidence<'a>,
     },
+}
+
+/// The starts an experience has observed, one per scene, each with what the
+/// driver saw at every step: the evidence [`DriverEstimate`] reads. The estimate
+/// is computed when asked ([`LessonEvent::driver_estimate`]), so an observer that
+/// does not ask pays nothing.
+#[derive(Debug, Clone, Copy)]
+pub struct DriverEvidence<'a> {
+    /// The experience's onsets, oldest first.
+    pub onsets: &'a [Onset],
+    /// The lane change's duration (s) a start must keep the safety layer's
+    /// distance for (the standard ALC's).
+    pub lane_change_duration_s: f64,
+}
+
+impl DriverEvidence<'_> {
+    /// What palc believes about the driver's start after these observations;
+    /// `None` before any onset recorded its scene.
+    pub fn estimate(&self) -> Option<DriverEstimate> {
+        DriverEstimate::from_onsets(self.onsets, self.lane_change_duration_s)
+    }
 }
 
 impl LessonEvent<'_> {
@@ -41,6 +68,17 @@ impl LessonEvent<'_> {
         match *self {
             LessonEvent::Learned { lane_change, .. } | LessonEvent::Failed { lane_change, .. } => {
                 lane_change
+            }
+        }
+    }
+
+    /// What palc believes about the driver after this lesson (the posterior over
+    /// start models, [`DriverEstimate`]); `None` before any onset recorded its
+    /// scene. Computed on each call.
+    pub fn driver_estimate(&self) -> Option<DriverEstimate> {
+        match self {
+            LessonEvent::Learned { driver, .. } | LessonEvent::Failed { driver, .. } => {
+                driver.estimate()
             }
         }
     }

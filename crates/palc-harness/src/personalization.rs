@@ -19,7 +19,7 @@ use palc_aggregator::{AggregatorOptions, Experience, Representation};
 use palc_planner::Weights;
 
 use crate::HarnessError;
-use crate::carry::{self, Names};
+use crate::carry::{self, Carried, Names};
 use crate::onset::{UserLaneChange, onset_at};
 use crate::scene_lessons::SceneLessons;
 use crate::setup::Setup;
@@ -102,7 +102,7 @@ pub trait Personalization: fmt::Debug + Send {
         standard_weights: &Weights,
         setup: &Setup,
         previous: Option<&Experience>,
-    ) -> Result<(Experience, Option<Vec<f64>>), HarnessError> {
+    ) -> Result<Carried, HarnessError> {
         carry::starting_experience(names, standard_weights, setup, previous, false)
     }
 
@@ -166,7 +166,7 @@ impl Personalization for RelativeOnset {
         standard_weights: &Weights,
         setup: &Setup,
         previous: Option<&Experience>,
-    ) -> Result<(Experience, Option<Vec<f64>>), HarnessError> {
+    ) -> Result<Carried, HarnessError> {
         carry::starting_experience(names, standard_weights, setup, previous, true)
     }
 }
@@ -221,7 +221,7 @@ impl<P: Personalization> Personalization for SceneAveraged<P> {
         standard_weights: &Weights,
         setup: &Setup,
         previous: Option<&Experience>,
-    ) -> Result<(Experience, Option<Vec<f64>>), HarnessError> {
+    ) -> Result<Carried, HarnessError> {
         self.inner.carry(names, standard_weights, setup, previous)
     }
 

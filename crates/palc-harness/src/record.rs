@@ -6,6 +6,7 @@ pub use palc_aggregator::Timings;
 use palc_aggregator::Experience;
 use serde::{Deserialize, Serialize};
 
+use crate::driver::CarriedBelief;
 use crate::method::Method;
 use crate::safety::{SafetyMetrics, Violation};
 use palc_user::TakeoverCause;
@@ -241,4 +242,9 @@ pub struct RunResult {
     pub records: Vec<LaneChangeRecord>,
     /// What was learned, to be saved or carried into another scenario.
     pub experience: Experience,
+    /// What the driver estimate believed when the experience this run started
+    /// from was carried in: `None` from scratch, for a method that carries in
+    /// the weights' own time base, and below two recorded scenes.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub carried_belief: Option<CarriedBelief>,
 }

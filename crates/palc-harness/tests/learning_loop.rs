@@ -333,6 +333,45 @@ fn observers_see_one_lesson_event_per_takeover_learned_from() {
     }
 }
 
+/// Records what each lesson event says palc believes about the driver.
+#[derive(Default)]
+struct Beliefs {
+    /// Per lesson: the onsets the event carried and the estimate's scenes, misfit and line.
+    seen: Vec<(usize, Option<(usize, bool, String)>)>,
+}
+
+impl palc_harness::Observer for Beliefs {
+    fn lesson(&mut self, event: &palc_harness::LessonEvent<'_>) {
+        let (palc_harness::LessonEvent::Learned { driver, .. }
+        | palc_harness::LessonEvent::Failed { driver, .. }) = event;
+        let estimate = event.driver_estimate();
+        self.seen.push((
+            driver.onsets.len(),
+            estimate.map(|e| (e.scenes(), e.outside_model(), e.describe())),
+        ));
+    }
+}
+
+#[test]
+fn every_lesson_event_says_what_palc_believes_about_the_driver_with_that_lesson() {
+    let config = config(Method::Palc, "neutral");
+    let mut beliefs = Beliefs::default();
+    let result = run(&config, None, &mut beliefs).unwrap();
+    assert!(result.summary.takeovers >= 1);
+    assert!(!beliefs.seen.is_empty());
+    // The first lesson's start is already in the event: one scene, recorded
+    // with what the user saw, and a headway user is inside the model.
+    let (onsets, estimate) = &beliefs.seen[0];
+    assert_eq!(*onsets, 1);
+    let (scenes, outside, line) = estimate.as_ref().expect("the scene was recorded");
+    assert_eq!(*scenes, 1);
+    assert!(!outside, "{line}");
+    assert!(line.contains("decides on the"), "{line}");
+    // The run's experience holds the same onsets the last event carried.
+    let (last_onsets, _) = beliefs.seen.last().unwrap();
+    assert_eq!(*last_onsets, result.experience.onsets.len());
+}
+
 #[test]
 fn stepping_the_loop_by_hand_gives_the_run() {
     let config = config(Method::Palc, "aggressive");
@@ -431,4 +470,45 @@ fn the_plans_follow_the_speed_the_user_drove() {
     for (x, y) in a.records.iter().zip(&b.records) {
         assert_eq!(x.planned_l, y.planned_l);
     }
+}
+
+#[test]
+fn a_run_keeps_what_the_estimate_believed_once_two_scenes_were_recorded() {
+    let in_cell = |method: Method, speed_case: &str, headway_m: f64| {
+        config(method, "neutral").with_cell(CellChoice {
+            speed_case: speed_case.into(),
+            headway_m,
+            seed: 1,
+        })
+    };
+    let chain = |method: Method| {
+        let first = learn(&in_cell(method, "collector-high", 40.0));
+        let second = run(
+            &in_cell(method, "arterial-slow", 50.0),
+            Some(&first.experience),
+            &mut NoObserver,
+        )
+        .unwrap();
+        let third = run(
+            &in_cell(method, "collector-slow", 30.0),
+            Some(&second.experience),
+            &mut NoObserver,
+        )
+        .unwrap();
+        [first, second, third]
+    };
+    let [scratch, one, two] = chain(Method::Palc);
+    // From scratch and with one recorded scene the estimate is not consulted.
+    assert_eq!(scratch.carried_belief, None);
+    assert_eq!(one.carried_belief, None);
+    let recorded = (one.experience.onsets.iter()).filter(|o| o.scene.is_some()).count();
+    assert_eq!(recorded, 2);
+    let belief = two.carried_belief.expect("two recorded scenes");
+    assert_eq!(belief.scenes, 2);
+    // The paper's neutral user decides on its time headway: inside the model.
+    assert!(!belief.outside_model, "{belief:?}");
+    assert!(belief.cue_mass > 0.0 && belief.cue_mass <= 1.0);
+    // `paper` carries its weights in their own time base: no estimate.
+    let [_, _, paper] = chain(Method::Paper);
+    assert_eq!(paper.carried_belief, None);
 }

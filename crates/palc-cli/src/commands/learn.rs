@@ -144,6 +144,12 @@ impl Observer for Printer {
         if let LessonEvent::Failed { error, .. } = event {
             say!("               learning step failed, experience unchanged: {error}");
         }
+        if let Some(estimate) = event.driver_estimate() {
+            say!(
+                "               the driver, as palc believes: {}",
+                estimate.describe()
+            );
+        }
     }
 
     fn finished(&mut self, summary: &RunSummary) {
@@ -190,7 +196,10 @@ pub fn run_learn(args: LearnArgs) -> anyhow::Result<()> {
         .with_context(|| args.scenario.whose_user())?;
     let duration_s = config.planning.standard_alc.lane_change_duration_s;
     if let Some(estimate) = DriverEstimate::from_onsets(&result.experience.onsets, duration_s) {
-        say!("the driver, as palc believes: {}", estimate.describe());
+        say!(
+            "after the run, the driver as palc believes: {}",
+            estimate.describe()
+        );
     }
     if let Some(path) = &args.save_experience {
         result

@@ -18,6 +18,7 @@ mod figures;
 mod front;
 mod lessons;
 mod manifest;
+mod outside;
 mod recorded;
 mod refusals;
 mod safety;
@@ -37,6 +38,7 @@ pub const SECTIONS: &[&dyn Section] = &[
     &recorded::Recorded,
     &transfer::Transfer,
     &drive::Drive,
+    &outside::Outside,
     &ablation::Ablation,
     &safety::Safety,
     &closed_loop::ClosedLoop,

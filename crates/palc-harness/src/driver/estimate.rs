@@ -599,7 +599,7 @@ mod tests {
         let seen: Vec<Onset> = seen.iter().map(|(_, o)| o.clone()).collect();
         // One scene is explained by a threshold of every cue: the readings predict.
         assert_eq!(
-            start_beyond_readings(&setups[target], &seen[..1], 2.0),
+            start_beyond_readings(&setups[target], &seen[..1], 2.0).start_s,
             None
         );
         let estimate = DriverEstimate::from_onsets(&seen, 2.0).unwrap();
@@ -614,7 +614,7 @@ mod tests {
             "{}",
             estimate.describe()
         );
-        let predicted = start_beyond_readings(&setups[target], &seen, 2.0);
+        let predicted = start_beyond_readings(&setups[target], &seen, 2.0).start_s;
         let predicted = predicted.expect("the scenes single the incentive out");
         let dt = setups[target].dt;
         assert!(
@@ -627,7 +627,12 @@ mod tests {
             .filter_map(|s| observed(&headway, s))
             .collect();
         assert!(seen.len() >= 2);
-        assert_eq!(start_beyond_readings(&setups[0], &seen, 2.0), None);
+        let carried = start_beyond_readings(&setups[0], &seen, 2.0);
+        assert_eq!(carried.start_s, None);
+        // What the estimate believed is kept: a headway driver inside the model.
+        let belief = carried.belief.expect("two recorded scenes or more");
+        assert_eq!(belief.scenes, seen.len());
+        assert!(!belief.outside_model);
     }
 
     #[test]

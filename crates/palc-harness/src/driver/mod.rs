@@ -16,7 +16,12 @@
 //! multiplying likelihoods. When no model explains every scene to within
 //! [`prior::MISFIT_SDS`] standard deviations, the driver is outside the model.
 //!
-//! `palc learn` prints the estimate after a run. The start carried into a new
+//! Every [`crate::LessonEvent`] hands its observers the evidence with that
+//! lesson's start included ([`crate::DriverEvidence`]); the estimate is computed
+//! when an observer asks (`palc learn` prints it after every lesson). A run
+//! keeps what the estimate believed when its experience was carried in
+//! ([`CarriedBelief`], in `RunResult::carried_belief`); the evaluation counts the
+//! misfits per user kind. The start carried into a new
 //! scene is predicted by the onsets' readings (`crate::onset`), which read the
 //! time headway, the time to collision and the distance gap; as the predictor
 //! for those cues the estimate's most probable model (and, separately, a refusal
@@ -34,6 +39,7 @@ pub use estimate::{DriverEstimate, Prediction};
 pub(crate) use scene::scene_steps;
 
 use palc_aggregator::Onset;
+use serde::{Deserialize, Serialize};
 
 use crate::setup::Setup;
 use prior::Cue;
@@ -51,25 +57,64 @@ const CREDIBLE_MASS: f64 = 0.95;
 /// explained by a threshold of every cue, so it cannot single one out.
 const MIN_SCENES: usize = 2;
 
-/// The start (s after the start of the plan) the estimate predicts in `setup`
-/// for a lane change of `duration_s`, when the estimate from `onsets` places the
-/// decision on a cue the readings do not read, with [`CREDIBLE_MASS`] of the
-/// posterior, from at least [`MIN_SCENES`] scenes: the readings cannot represent
-/// such a driver, the estimate can. `None` otherwise (the readings predict), and
-/// for a driver outside the model or a scene the estimate says it does not start in.
+/// What the estimate believed when an experience was carried into a new scene:
+/// its dominant cue, that cue's posterior mass, the scenes it had seen and
+/// whether it called the driver outside the model. The evaluation counts the
+/// misfits per user kind (REPORT.md, "Drivers outside the model").
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CarriedBelief {
+    /// Recorded scenes the estimate was computed from.
+    pub scenes: usize,
+    /// The cue with the largest posterior mass.
+    pub cue: Cue,
+    /// That cue's posterior mass.
+    pub cue_mass: f64,
+    /// No start model explained every scene ([`DriverEstimate::outside_model`]).
+    pub outside_model: bool,
+}
+
+/// What the estimate says when an experience from `onsets` is carried into
+/// `setup`, for a lane change of `duration_s`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub(crate) struct CarriedEstimate {
+    /// The start (s after the start of the plan) the estimate predicts, when it
+    /// places the decision on a cue the readings do not read, with
+    /// [`CREDIBLE_MASS`] of the posterior, from at least [`MIN_SCENES`] scenes:
+    /// the readings cannot represent such a driver, the estimate can. `None`
+    /// otherwise (the readings predict), and for a driver outside the model or a
+    /// scene the estimate says it does not start in.
+    pub start_s: Option<f64>,
+    /// What the estimate believed; `None` below [`MIN_SCENES`] recorded scenes,
+    /// where it is not computed.
+    pub belief: Option<CarriedBelief>,
+}
+
+/// The estimate's say when an experience from `onsets` is carried into `setup`
+/// ([`CarriedEstimate`]).
 pub(crate) fn start_beyond_readings(
     setup: &Setup,
     onsets: &[Onset],
     duration_s: f64,
-) -> Option<f64> {
+) -> CarriedEstimate {
     // Only onsets that recorded their scene inform the estimate.
     if onsets.iter().filter(|o| o.scene.is_some()).count() < MIN_SCENES {
-        return None;
+        return CarriedEstimate::default();
     }
-    let estimate = DriverEstimate::from_onsets(onsets, duration_s)?;
+    let Some(estimate) = DriverEstimate::from_onsets(onsets, duration_s) else {
+        return CarriedEstimate::default();
+    };
     let (cue, mass) = estimate.dominant_cue();
+    let belief = Some(CarriedBelief {
+        scenes: estimate.scenes(),
+        cue,
+        cue_mass: mass,
+        outside_model: estimate.outside_model(),
+    });
     if READ_BY_THE_READINGS.contains(&cue) || mass < CREDIBLE_MASS {
-        return None;
+        return CarriedEstimate {
+            start_s: None,
+            belief,
+        };
     }
     let steps = scene_steps(setup);
     let safe: Option<Vec<bool>> = steps.steps.iter().map(|s| s.safe).collect();
@@ -80,8 +125,9 @@ pub(crate) fn start_beyond_readings(
         safe.as_deref(),
         duration_s,
     );
-    match predicted {
+    let start_s = match predicted {
         Prediction::Start(start_s) => Some(start_s),
         Prediction::NoStart | Prediction::OutsideModel => None,
-    }
+    };
+    CarriedEstimate { start_s, belief }
 }

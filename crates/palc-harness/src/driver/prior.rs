@@ -11,6 +11,7 @@ use palc_user::{
     DISTANCE_START_BOUNDS_M, INCENTIVE_SAFE_DECELERATION_MPS2, INCENTIVE_START_BOUNDS_MPS2,
     Situation, StartRule, TTC_START_BOUNDS_S, incentive_mps2,
 };
+use serde::{Deserialize, Serialize};
 
 /// Standard deviation (s) of an observed start around the start a model
 /// predicts: the fitted start is within 0.15 s of a lane change's true start
@@ -59,7 +60,8 @@ pub fn cue_mass(cue: Cue) -> f64 {
 }
 
 /// The cue a decision is taken on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
 pub enum Cue {
     /// Time headway to the vehicle ahead.
     TimeHeadway,

@@ -103,6 +103,7 @@ impl LearningLoop {
             summary,
             records: self.run.records,
             experience: self.learner.experience,
+            carried_belief: self.learner.carried_belief,
         }
     }
 }

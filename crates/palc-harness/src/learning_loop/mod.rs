@@ -30,9 +30,10 @@ use crate::carry::{Names, rehearse};
 use crate::closed_loop::ClosedLoop;
 use crate::config::{LearnConfig, StoppingConfig};
 use crate::drive::{Drive, execute_in, judge, plan_safety, problem};
+use crate::driver::CarriedBelief;
 use crate::lesson::{lesson, scenes, zone_feature_set};
 use crate::method::Method;
-use crate::observer::{LessonEvent, Observer};
+use crate::observer::{DriverEvidence, LessonEvent, Observer};
 use crate::personalization::{self, LessonPaths, Personalization};
 use crate::record::{FrozenEvaluation, LaneChangeRecord, Outcome, RunResult};
 use crate::refusal::Refusal;
@@ -109,6 +110,8 @@ struct Learner {
     next_plan: Plan,
     /// Compute time of the step that produced `next_plan`.
     pending_times: Timings,
+    /// What the driver estimate believed when the experience was carried in.
+    carried_belief: Option<CarriedBelief>,
 }
 
 impl LearningLoop {
@@ -166,8 +169,9 @@ impl LearningLoop {
             scenario: &label,
             method: config.method.name(),
         };
-        let (experience, rehearsal) =
-            personalization.carry(names, &standard_weights, &setup, experience)?;
+        let carried = personalization.carry(names, &standard_weights, &setup, experience)?;
+        let (experience, rehearsal) = (carried.experience, carried.rehearsal);
+        let carried_belief = carried.belief;
         let mut planner = Planner::new(PlannerConfig {
             horizon: setup.horizon,
             dt: setup.dt,
@@ -237,6 +241,7 @@ impl LearningLoop {
                 experience,
                 next_plan,
                 pending_times,
+                carried_belief,
             },
             run: RunState::default(),
         })
@@ -352,6 +357,7 @@ impl LearningLoop {
             summary,
             records: self.run.records,
             experience: self.learner.experience,
+            carried_belief: self.learner.carried_belief,
         })
     }
 
@@ -576,28 +582,37 @@ impl LearningLoop {
             &self.scenario.template,
             &self.policy.options,
         );
+        let lane_change_duration_s = setup.standard_alc.lane_change_duration_s;
         match result {
-            Ok(outcome) => {
-                observer.lesson(&LessonEvent::Learned {
-                    lane_change,
-                    lesson: &lesson,
-                    outcome: &outcome,
-                });
-                learner.pending_times = outcome.timings;
-                learner.experience = outcome.experience;
-                learner.next_plan = outcome.plan;
+            Ok(mut outcome) => {
                 if let Some(start_s) = demonstration.start_s {
-                    let experience = &mut learner.experience;
+                    let experience = &mut outcome.experience;
                     learner
                         .personalization
                         .observe_start(experience, setup, start_s);
                 }
+                observer.lesson(&LessonEvent::Learned {
+                    lane_change,
+                    lesson: &lesson,
+                    outcome: &outcome,
+                    driver: DriverEvidence {
+                        onsets: &outcome.experience.onsets,
+                        lane_change_duration_s,
+                    },
+                });
+                learner.pending_times = outcome.timings;
+                learner.experience = outcome.experience;
+                learner.next_plan = outcome.plan;
             }
             Err(error) => {
                 observer.lesson(&LessonEvent::Failed {
                     lane_change,
                     lesson: &lesson,
                     error: &error,
+                    driver: DriverEvidence {
+                        onsets: &learner.experience.onsets,
+                        lane_change_duration_s,
+                    },
                 });
                 self.run.learning_failures += 1;
                 self.run.last_lesson_failed = true;
