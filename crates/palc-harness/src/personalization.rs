@@ -62,10 +62,10 @@ impl<'a> LessonPaths<'a> {
     }
 
     /// The user's own lane change fitted to what it drove after the takeover
-    /// (`onset::UserLaneChange::fit`); `None` when too little is left to fit.
+    /// (`onset::UserLaneChange::fit_lesson`); `None` when too little is left to fit.
     fn fitted(&self) -> Option<UserLaneChange> {
         *self.fitted.get_or_init(|| {
-            UserLaneChange::fit(self.driven_l, self.takeover_step, self.dt, self.target_l)
+            UserLaneChange::fit_lesson(self.driven_l, self.takeover_step, self.dt, self.target_l)
         })
     }
 }

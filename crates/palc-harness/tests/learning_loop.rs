@@ -501,7 +501,9 @@ fn a_run_keeps_what_the_estimate_believed_once_two_scenes_were_recorded() {
     // From scratch and with one recorded scene the estimate is not consulted.
     assert_eq!(scratch.carried_belief, None);
     assert_eq!(one.carried_belief, None);
-    let recorded = (one.experience.onsets.iter()).filter(|o| o.scene.is_some()).count();
+    let recorded = (one.experience.onsets.iter())
+        .filter(|o| o.scene.is_some())
+        .count();
     assert_eq!(recorded, 2);
     let belief = two.carried_belief.expect("two recorded scenes");
     assert_eq!(belief.scenes, 2);

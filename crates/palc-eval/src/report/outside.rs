@@ -67,11 +67,7 @@ impl Section for Outside {
                 "cue most often believed",
             ],
         )?;
-        let drives = drive_report::drives(
-            results.input.rows,
-            results.methods(),
-            Experiment::Drive,
-        );
+        let drives = drive_report::drives(results.input.rows, results.methods(), Experiment::Drive);
         for &method in results.methods() {
             for kind in results.input.user_kinds {
                 let beliefs = Beliefs::of(results, method, &kind.name);
@@ -132,12 +128,11 @@ impl Beliefs {
 
     /// The cue most often believed, with its share; the first name among equals.
     fn most_often(&self) -> String {
-        let best = (self.cues.iter()).fold(None, |best: Option<(&str, usize)>, (&cue, &n)| {
-            match best {
+        let best =
+            (self.cues.iter()).fold(None, |best: Option<(&str, usize)>, (&cue, &n)| match best {
                 Some((_, m)) if m >= n => best,
                 _ => Some((cue, n)),
-            }
-        });
+            });
         match best {
             Some((cue, n)) => format!("{cue} ({})", pct(Some(n as f64 / self.judged as f64))),
             None => "-".to_owned(),

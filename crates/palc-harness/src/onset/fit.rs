@@ -1,5 +1,10 @@
 //! Where a lane change started, from the part of it seen after a takeover: a
 //! lane-change model ([`Shape`]) fitted through two crossings of the profile.
+//! When the user took over before its own start and was seen keeping its lane,
+//! the start is held between the last step it was seen at rest and the first it
+//! had moved ([`UserLaneChange::fit_lesson`]): what was seen outranks the
+//! model, whose onset a real driver's need not share
+//! (docs/experiments/0075-what-palc-believes-and-recorded-drivers.md).
 
 /// The lower fraction of the lane change whose crossing anchors the fit: low
 /// enough to lie early in the move, high enough to lie clear of the takeover's
@@ -31,6 +36,16 @@ const COARSE_PEAK_STEP: f64 = 0.05;
 /// The fine grid around the coarse best: a peak off by 0.01 moves the start by
 /// well under a step of the grid's planning (0.1 s) for the paper's durations.
 const FINE_PEAK_STEP: f64 = 0.01;
+/// The lateral offset (m) within which a driven path counts as at rest in its
+/// lane: when the user took over before its own start, the steps it then kept
+/// its lane bound its start whatever the shape of its onset (a recorded
+/// driver's onset is in neither base; fitted, its start came out up to 1.3 s
+/// early). A micrometre, because the paths palc's users drive are free of
+/// sensor noise, and the smoothest onset of the bases (the quintic's cubic) stays
+/// below it for 0.3 % of its duration (0.012 s of a 4 s lane change), well
+/// under a step. A noisy path is never at rest by this measure, and is fitted
+/// as before.
+const REST_M: f64 = 1e-6;
 
 /// The symmetric lane-change models a user's start is fitted with: the paper's
 /// quintic (minimum jerk, a cubic onset) and the half-sine lateral speed of many
@@ -232,6 +247,38 @@ impl UserLaneChange {
         Some(best)
     }
 
+    /// [`UserLaneChange::fit`] to a lesson, where the user drove `driven_l`
+    /// itself from `takeover_step` on: when it was then seen at rest in its lane
+    /// before moving, its start is held within what was seen ([`REST_M`]). Not for
+    /// paths the system drove (their numerical drift is no rest).
+    pub(crate) fn fit_lesson(
+        driven_l: &[f64],
+        takeover_step: usize,
+        dt: f64,
+        target_l: f64,
+    ) -> Option<UserLaneChange> {
+        let fitted = UserLaneChange::fit(driven_l, takeover_step, dt, target_l)?;
+        Some(match rest_bounds_s(driven_l, takeover_step, dt) {
+            Some(bounds) => fitted.started_within(bounds),
+            None => fitted,
+        })
+    }
+
+    /// This lane change with its start moved into `(earliest, latest)` (s), its
+    /// end kept: what was seen of the user outranks the model's extrapolation.
+    fn started_within(self, (earliest, latest): (f64, f64)) -> UserLaneChange {
+        let start_s = self.start_s.clamp(earliest, latest);
+        let end_s = self.start_s + self.duration_s;
+        if start_s == self.start_s || end_s <= start_s {
+            return self;
+        }
+        UserLaneChange {
+            start_s,
+            duration_s: end_s - start_s,
+            ..self
+        }
+    }
+
     /// The fitted lateral position (m) at time `t` (s): 0 before the start.
     pub(crate) fn lateral(&self, t: f64) -> f64 {
         let x = ((t - self.start_s) / self.duration_s).clamp(0.0, 1.0);
@@ -252,6 +299,17 @@ impl UserLaneChange {
             })
             .collect()
     }
+}
+
+/// The interval (s) the user's start lies in when it was seen at rest in its lane
+/// from the takeover on ([`REST_M`]): after the last step at rest, no later than
+/// the first step it had moved. `None` when it had already left its lane at the
+/// takeover, or never moved in what was seen.
+fn rest_bounds_s(driven_l: &[f64], takeover_step: usize, dt: f64) -> Option<(f64, f64)> {
+    let after = driven_l.get(takeover_step..)?;
+    let moved = after.iter().position(|l| l.abs() > REST_M)?;
+    let last_rest = takeover_step + moved.checked_sub(1)?;
+    Some((last_rest as f64 * dt, (last_rest + 1) as f64 * dt))
 }
 
 #[cfg(test)]
@@ -431,5 +489,53 @@ mod tests {
         // At step 25 the user is past 80 % of the lane change.
         assert_eq!(UserLaneChange::fit(&profile, 25, 0.1, 3.5), None);
         assert_eq!(UserLaneChange::fit(&profile, 5, 0.1, 0.0), None);
+    }
+
+    /// A lane change whose onset is in neither base: its lateral speed jumps at
+    /// the start and falls off as a cubic (`p(x) = 1 − (1 − x)³`).
+    fn abrupt_profile(start: f64, duration: f64, dt: f64, n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|i| {
+                let x = ((i as f64 * dt - start) / duration).clamp(0.0, 1.0);
+                3.5 * (1.0 - (1.0 - x).powi(3))
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_start_seen_from_rest_is_held_within_what_was_seen_whatever_the_onset() {
+        let (start, dt) = (5.03, 0.1);
+        let driven = abrupt_profile(start, 3.0, dt, 120);
+        // The takeover at 4.0 s came before the start: the user kept its lane
+        // until step 50 and had moved at step 51.
+        let fitted = UserLaneChange::fit(&driven, 40, dt, 3.5).unwrap();
+        assert!((fitted.start_s - start).abs() > dt, "{fitted:?}");
+        let seen = UserLaneChange::fit_lesson(&driven, 40, dt, 3.5).unwrap();
+        assert!((seen.start_s - start).abs() <= dt, "{seen:?}");
+        // The end of the lane change is the model's.
+        let end = |u: &UserLaneChange| u.start_s + u.duration_s;
+        assert!((end(&seen) - end(&fitted)).abs() < 1e-9);
+    }
+
+    #[test]
+    fn a_start_the_model_places_within_what_was_seen_is_kept() {
+        let driven = quintic_profile(5.03, 3.0, 0.1, 120);
+        for takeover in [30, 45, 50] {
+            let fitted = UserLaneChange::fit(&driven, takeover, 0.1, 3.5).unwrap();
+            let seen = UserLaneChange::fit_lesson(&driven, takeover, 0.1, 3.5).unwrap();
+            assert_eq!(seen, fitted, "takeover at step {takeover}");
+        }
+    }
+
+    #[test]
+    fn a_user_moving_at_the_takeover_or_a_noisy_path_shows_no_rest() {
+        let driven = abrupt_profile(5.03, 3.0, 0.1, 120);
+        assert_eq!(rest_bounds_s(&driven, 52, 0.1), None);
+        let noisy: Vec<f64> = (driven.iter().enumerate())
+            .map(|(i, l)| l + if i % 2 == 0 { 1e-3 } else { -1e-3 })
+            .collect();
+        assert_eq!(rest_bounds_s(&noisy, 40, 0.1), None);
+        let (earliest, latest) = rest_bounds_s(&driven, 40, 0.1).unwrap();
+        assert!((earliest - 5.0).abs() < 1e-9 && (latest - 5.1).abs() < 1e-9);
     }
 }
