@@ -61,6 +61,7 @@ pub const TABLE_FILES: &[&str] = &[
     transfer::ACCUMULATION_FILE,
     ablation::FILE,
     lessons::FILE,
+    outside::FILE,
 ];
 
 /// Writes REPORT.md's text and the CSV tables beside it.

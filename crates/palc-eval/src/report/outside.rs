@@ -5,7 +5,8 @@
 //! start model that explains every scene the driver was seen in (a misfit,
 //! `palc_harness::driver::DriverEstimate::outside_model`) and the cue it most
 //! often put the decision on. Recorded and out-of-class kinds
-//! ([`UserKind::is_out_of_class`]) stand beside palc's own families.
+//! ([`UserKind::is_out_of_class`]) stand in the text beside the paper's
+//! deterministic users; every kind is in [`FILE`].
 
 use std::collections::BTreeMap;
 use std::fmt::{self, Write as _};
@@ -22,6 +23,33 @@ use crate::stats::{self, Summary};
 
 /// The drive's band the table shows (lane changes, counted from 1).
 const DRIVE_BAND: (usize, usize) = (11, 50);
+
+/// The CSV file of the table, every user kind.
+pub const FILE: &str = "outside-the-model.csv";
+const COLUMNS: &[&str] = &[
+    "method",
+    "user_kind",
+    "class",
+    "from_scratch_personalized_mean_takeovers",
+    "transfer_scratch_to_with_experience",
+    "accumulation_scratch_to_with_experience",
+    "drive_lane_changes_11_50_taken_over",
+    "carries_judged",
+    "outside_the_model",
+    "cue_most_often_believed",
+];
+/// The text table's columns but the drive's band (inserted at 6).
+const TEXT_COLUMNS: &[&str] = &[
+    "method",
+    "user",
+    "class",
+    "from scratch: personalized, mean takeovers",
+    "experience from another scene: scratch -> with",
+    "after accumulation: scratch -> with",
+    "carries the estimate judged",
+    "outside the model",
+    "cue most often believed",
+];
 
 /// The drivers-outside-the-model section.
 pub struct Outside;
@@ -49,24 +77,14 @@ impl Section for Outside {
                 ),
                 ("first", DRIVE_BAND.0.to_string()),
                 ("last", DRIVE_BAND.1.to_string()),
+                ("file", FILE.to_owned()),
             ],
         );
         writeln!(out, "{text}\n")?;
-        header(
-            out,
-            &[
-                "method",
-                "user",
-                "class",
-                "from scratch: personalized, mean takeovers",
-                "experience from another scene: scratch -> with",
-                "after accumulation: scratch -> with",
-                &format!("drive, lane changes {}-{}", DRIVE_BAND.0, DRIVE_BAND.1),
-                "carries the estimate judged",
-                "outside the model",
-                "cue most often believed",
-            ],
-        )?;
+        let band = format!("drive, lane changes {}-{}", DRIVE_BAND.0, DRIVE_BAND.1);
+        let mut columns = TEXT_COLUMNS.to_vec();
+        columns.insert(6, &band);
+        header(out, &columns)?;
         let drives = drive_report::drives(results.input.rows, results.methods(), Experiment::Drive);
         for &method in results.methods() {
             for kind in results.input.user_kinds {
@@ -75,24 +93,28 @@ impl Section for Outside {
                     continue;
                 }
                 let drive = (drives.iter()).find(|d| d.method == method && d.user == kind.name);
-                writeln!(
-                    out,
-                    "| `{}` | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
-                    method.name(),
-                    kind.name,
-                    class(kind),
+                let line = vec![
+                    method.name().to_owned(),
+                    kind.name.clone(),
+                    class(kind).to_owned(),
                     from_scratch(results, method, &kind.name),
                     transfer(results, method, &kind.name, Experiment::Transfer),
                     transfer(results, method, &kind.name, Experiment::Accumulation),
                     drive.map_or_else(|| "-".to_owned(), drive_rate),
-                    beliefs.judged,
-                    format_args!(
+                    beliefs.judged.to_string(),
+                    format!(
                         "{} ({})",
                         beliefs.outside,
                         pct(Some(beliefs.outside as f64 / beliefs.judged as f64))
                     ),
                     beliefs.most_often(),
-                )?;
+                ];
+                // In the text: the kinds outside palc's families, and the paper's
+                // deterministic users for reference; every kind in the CSV file.
+                if kind.is_out_of_class() || kind.name == UserKind::deterministic().name {
+                    writeln!(out, "| {} |", line.join(" | "))?;
+                }
+                out.table(FILE, COLUMNS).rows.push(line);
             }
         }
         writeln!(out)

@@ -139,13 +139,41 @@ fn shorten(text: &str) -> String {
 }
 
 /// The kind of a run's error: its first clause (`what failed`), without the
-/// details after the first colon.
+/// scenario it names first (`scenario <label>: `), the details after the next
+/// colon and the numbers in brackets, so that one cause is one line whatever
+/// scene it happened in.
 fn failure_kind(error: &str) -> &str {
-    error.split_once(": ").map_or(error, |(kind, _)| kind)
+    let what = match error.strip_prefix("scenario ") {
+        Some(rest) => rest.split_once(": ").map_or(error, |(_, what)| what),
+        None => error,
+    };
+    let clause = what.split_once(": ").map_or(what, |(kind, _)| kind);
+    clause
+        .split_once(" (")
+        .map_or(clause, |(kind, _)| kind)
+        .trim_end()
 }
 
 #[cfg(test)]
 mod tests {
+    use super::failure_kind;
+
+    #[test]
+    fn an_errors_kind_leaves_out_its_scenario_details_and_numbers() {
+        let off_road = "scenario collector-high / 50 m / seed 2 / aggressive: the experience's weights plan \
+                        the first lane change off the road (l = -4.11 m at step 12)";
+        assert_eq!(
+            failure_kind(off_road),
+            "the experience's weights plan the first lane change off the road"
+        );
+        let solver = "problem is infeasible: lateral bounds at steps 170 cannot hold";
+        assert_eq!(failure_kind(solver), "problem is infeasible");
+        assert_eq!(
+            failure_kind("scenario without a colon"),
+            "scenario without a colon"
+        );
+    }
+
     #[test]
     fn a_long_example_is_cut_on_a_character() {
         let long = "é".repeat(300);
