@@ -47,6 +47,16 @@ def test_the_loop_yields_every_lane_change_and_the_same_result_as_learn() -> Non
         next(learning)
 
 
+def test_the_loop_says_what_it_believes_about_the_driver_after_a_lesson() -> None:
+    learning = palc.LearningLoop(config())
+    assert learning.driver_estimate() is None
+    first = next(learning)
+    assert first["takeover"] is not None, "the standard plan is taken over"
+    belief = learning.driver_estimate()
+    assert belief is not None and "decides on the time-headway" in belief, belief
+    assert "scenes seen: 1" in belief
+
+
 def test_result_runs_a_loop_to_its_end() -> None:
     learning = palc.LearningLoop(config())
     first = next(learning)

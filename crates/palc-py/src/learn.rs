@@ -11,6 +11,7 @@ use std::path::PathBuf;
 use std::sync::Mutex;
 
 use palc_aggregator::Experience as RustExperience;
+use palc_harness::driver::DriverEstimate;
 use palc_harness::{HarnessError, LaneChangeRecord, NoObserver, RunResult};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -468,6 +469,20 @@ impl LearningLoop {
                 .and_then(|learning| learning.termination())
                 .map(|o| serialize(py, &o))
                 .transpose()
+        })
+    }
+
+    /// What palc believes about the driver's start after the lessons so far, in one
+    /// line: the most probable start model (the cue and its threshold, the reaction,
+    /// the gaps accepted) with its cue's posterior mass, or that no start model explains
+    /// every scene the driver was seen in; ``None`` before a start was recorded.
+    fn driver_estimate(&self, py: Python<'_>) -> PyResult<Option<String>> {
+        self.with(py, |slot| {
+            Ok(slot.as_ref().and_then(|learning| {
+                let duration_s = learning.setup().standard_alc.lane_change_duration_s;
+                DriverEstimate::from_onsets(&learning.experience().onsets, duration_s)
+                    .map(|estimate| estimate.describe())
+            }))
         })
     }
 
