@@ -333,11 +333,14 @@ fn observers_see_one_lesson_event_per_takeover_learned_from() {
     }
 }
 
+/// The estimate a lesson event gave: its scenes, misfit and line.
+type Estimated = (usize, bool, String);
+
 /// Records what each lesson event says palc believes about the driver.
 #[derive(Default)]
 struct Beliefs {
-    /// Per lesson: the onsets the event carried and the estimate's scenes, misfit and line.
-    seen: Vec<(usize, Option<(usize, bool, String)>)>,
+    /// Per lesson: the onsets the event carried and the estimate.
+    seen: Vec<(usize, Option<Estimated>)>,
 }
 
 impl palc_harness::Observer for Beliefs {
