@@ -26,7 +26,7 @@ pub struct Names<'a> {
     pub method: &'a str,
 }
 
-/// An experience carried into a scene ([`starting_experience`]).
+/// An experience carried into a scene ([`Personalization::carry`](crate::advanced::Personalization::carry)).
 #[derive(Debug, Clone)]
 pub struct Carried {
     /// The experience the run starts from.
