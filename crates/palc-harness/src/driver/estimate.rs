@@ -85,6 +85,14 @@ impl Grid {
     /// have changed lanes before the system planned (palc-user refuses such a
     /// scene for a simulated user).
     fn starts(&self, scene: &SceneView<'_>) -> Vec<u32> {
+        let mut starts = vec![NEVER; self.len()];
+        self.for_each_start(scene, |h, start| starts[h] = start);
+        starts
+    }
+
+    /// Calls `visit(h, start)` once for every hypothesis `h` with its start step
+    /// in the scene, as [`Grid::starts`] lists them, without the list.
+    fn for_each_start(&self, scene: &SceneView<'_>, mut visit: impl FnMut(usize, u32)) {
         let n = scene.situations.len();
         let mut decision = vec![NEVER; self.thresholds];
         for (cue, first, thresholds) in &self.cues {
@@ -103,7 +111,6 @@ impl Grid {
                 }
             }
         }
-        let mut starts = vec![NEVER; self.len()];
         let mut next = vec![NEVER; n + 1];
         for (lead_index, &lead) in LEAD_GAPS_S.iter().enumerate() {
             for (lag_index, &lag) in LAG_GAPS_S.iter().enumerate() {
@@ -119,16 +126,17 @@ impl Grid {
                 for (reaction_index, &reaction_s) in REACTIONS_S.iter().enumerate() {
                     let reaction = StartModel { reaction_s, ..gaps }.reaction_steps(scene.dt);
                     let c = combination_index(reaction_index, lead_index, lag_index);
-                    let out = &mut starts[c * self.thresholds..(c + 1) * self.thresholds];
-                    for (start, &decided) in out.iter_mut().zip(&decision) {
-                        if decided != NEVER {
-                            *start = next[(decided as usize).saturating_add(reaction).min(n)];
-                        }
+                    for (t, &decided) in decision.iter().enumerate() {
+                        let start = if decided != NEVER {
+                            next[(decided as usize).saturating_add(reaction).min(n)]
+                        } else {
+                            NEVER
+                        };
+                        visit(c * self.thresholds + t, start);
                     }
                 }
             }
         }
-        starts
     }
 }
 
@@ -258,13 +266,12 @@ impl DriverEstimate {
                 safe.as_deref(),
                 duration_s,
             );
-            let starts = grid.starts(&view);
             let misfit = Misfit::new(seen.len(), scene.dt, onset.time_s);
-            for ((lp, far), &start) in log_posterior.iter_mut().zip(&mut worst).zip(&starts) {
+            grid.for_each_start(&view, |h, start| {
                 let (error, penalty) = misfit.of(start);
-                *far = far.max(error);
-                *lp -= penalty;
-            }
+                worst[h] = worst[h].max(error);
+                log_posterior[h] -= penalty;
+            });
             scenes += 1;
         }
         if scenes == 0 {
@@ -357,19 +364,25 @@ impl DriverEstimate {
 
     /// The posterior mass of each cue.
     pub fn cue_masses(&self) -> Vec<(&'static str, f64)> {
-        let weights = self.weights();
-        let total: f64 = weights.iter().sum();
+        let top = self.top();
         let nt = self.grid.thresholds;
-        (self.grid.cues.iter())
-            .map(|(cue, first, thresholds)| {
-                let mass: f64 = (0..Grid::combinations())
-                    .flat_map(|c| {
-                        let start = c * nt + first;
-                        weights[start..start + thresholds.len()].iter()
-                    })
-                    .sum();
-                (cue.name(), if total > 0.0 { mass / total } else { 0.0 })
-            })
+        // One pass in hypothesis order: the total and each cue's mass add their
+        // weights in the order of a sum over the weights (the cues' thresholds
+        // are consecutive, in the order of the cues).
+        let mut total = -0.0;
+        let mut masses = vec![-0.0; self.grid.cues.len()];
+        for c in 0..Grid::combinations() {
+            for ((_, first, thresholds), mass) in self.grid.cues.iter().zip(&mut masses) {
+                let start = c * nt + first;
+                for &lp in &self.log_posterior[start..start + thresholds.len()] {
+                    let weight = weight(lp, top);
+                    total += weight;
+                    *mass += weight;
+                }
+            }
+        }
+        (self.grid.cues.iter().zip(masses))
+            .map(|((cue, _, _), mass)| (cue.name(), if total > 0.0 { mass / total } else { 0.0 }))
             .collect()
     }
 
@@ -396,21 +409,23 @@ impl DriverEstimate {
         }
     }
 
-    /// The posterior weights, scaled so that the largest is 1.
-    fn weights(&self) -> Vec<f64> {
-        let top = (self.log_posterior.iter().copied()).fold(f64::NEG_INFINITY, f64::max);
-        (self.log_posterior.iter())
-            .map(|&lp| {
-                let below_top = lp - top;
-                // `exp` is exactly +0 below its underflow (about -745.13): the
-                // many hypotheses far from the top skip the call.
-                if !top.is_finite() || below_top < EXP_UNDERFLOW {
-                    0.0
-                } else {
-                    below_top.exp()
-                }
-            })
-            .collect()
+    /// The largest log posterior.
+    fn top(&self) -> f64 {
+        (self.log_posterior.iter().copied()).fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
+/// The posterior weight of a hypothesis of log posterior `lp`, scaled so that
+/// the largest (`top`) is 1.
+#[inline]
+fn weight(lp: f64, top: f64) -> f64 {
+    let below_top = lp - top;
+    // `exp` is exactly +0 below its underflow (about -745.13): the many
+    // hypotheses far from the top skip the call.
+    if !top.is_finite() || below_top < EXP_UNDERFLOW {
+        0.0
+    } else {
+        below_top.exp()
     }
 }
 
