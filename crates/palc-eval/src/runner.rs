@@ -390,6 +390,54 @@ pub(crate) mod tests {
         execute(&plan, &Synthetic, 2, &NoProgress).unwrap()
     }
 
+    /// [`Synthetic`] with an experience that depends only on what the run computes,
+    /// counting the runs it computes; with `share`, it names what determines a
+    /// run, so that the runner shares repeats.
+    struct Counting {
+        share: bool,
+        computed: std::sync::atomic::AtomicUsize,
+    }
+
+    impl Executor for Counting {
+        type Experience = usize;
+
+        fn run(&self, spec: &RunSpec, experience: Option<&usize>) -> (RunRow, Option<usize>) {
+            self.computed
+                .fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+            let (row, learned) = Synthetic.run(spec, experience);
+            (row, learned.map(|_| 1))
+        }
+
+        fn cap(&self) -> usize {
+            Synthetic.cap()
+        }
+
+        fn identity(&self, spec: &RunSpec) -> Option<String> {
+            self.share.then(|| {
+                let dt = spec.dt.map(f64::to_bits);
+                format!("{:?}", (spec.experiment_cell(), &spec.speed_case.name, dt))
+            })
+        }
+    }
+
+    #[test]
+    fn shared_repeats_give_the_rows_of_computing_every_run() {
+        let plan = plan::expand(&plan::tests::selection(), &plan::tests::testbed()).unwrap();
+        let counting = |share| Counting {
+            share,
+            computed: Default::default(),
+        };
+        let (every, shared) = (counting(false), counting(true));
+        let all = execute(&plan, &every, 2, &NoProgress).unwrap();
+        let once = execute(&plan, &shared, 2, &NoProgress).unwrap();
+        assert_eq!(all, once);
+        let computed = |e: &Counting| e.computed.load(std::sync::atomic::Ordering::SeqCst);
+        assert!(
+            computed(&shared) < computed(&every),
+            "the plan repeats runs (transfer and matrix pairs), computed once"
+        );
+    }
+
     /// Cancels once `after` runs have finished, counting the runs finished.
     struct CancelAfter {
         after: usize,
