@@ -1,5 +1,7 @@
 //! The posterior over start models and the start it predicts in a new scene.
 
+use std::ops::Range;
+
 use palc_aggregator::Onset;
 use palc_user::{Situation, StartModel};
 
@@ -86,13 +88,14 @@ impl Grid {
     /// scene for a simulated user).
     fn starts(&self, scene: &SceneView<'_>) -> Vec<u32> {
         let mut starts = vec![NEVER; self.len()];
-        self.for_each_start(scene, |h, start| starts[h] = start);
+        self.for_each_start(scene, |hypotheses, start| starts[hypotheses].fill(start));
         starts
     }
 
-    /// Calls `visit(h, start)` once for every hypothesis `h` with its start step
-    /// in the scene, as [`Grid::starts`] lists them, without the list.
-    fn for_each_start(&self, scene: &SceneView<'_>, mut visit: impl FnMut(usize, u32)) {
+    /// Calls `visit(hypotheses, start)` with every hypothesis once, as [`Grid::starts`]
+    /// lists them, without the list: `hypotheses` are consecutive thresholds of one
+    /// combination that decide at the same step, and so start at the same step.
+    fn for_each_start(&self, scene: &SceneView<'_>, mut visit: impl FnMut(Range<usize>, u32)) {
         let n = scene.situations.len();
         let mut decision = vec![NEVER; self.thresholds];
         for (cue, first, thresholds) in &self.cues {
@@ -111,6 +114,14 @@ impl Grid {
                 }
             }
         }
+        // The thresholds in runs of the same decision step.
+        let mut runs: Vec<(Range<usize>, u32)> = Vec::new();
+        for (t, &decided) in decision.iter().enumerate() {
+            match runs.last_mut() {
+                Some((range, step)) if *step == decided => range.end = t + 1,
+                _ => runs.push((t..t + 1, decided)),
+            }
+        }
         let mut next = vec![NEVER; n + 1];
         for (lead_index, &lead) in LEAD_GAPS_S.iter().enumerate() {
             for (lag_index, &lag) in LAG_GAPS_S.iter().enumerate() {
@@ -126,13 +137,14 @@ impl Grid {
                 for (reaction_index, &reaction_s) in REACTIONS_S.iter().enumerate() {
                     let reaction = StartModel { reaction_s, ..gaps }.reaction_steps(scene.dt);
                     let c = combination_index(reaction_index, lead_index, lag_index);
-                    for (t, &decided) in decision.iter().enumerate() {
-                        let start = if decided != NEVER {
-                            next[(decided as usize).saturating_add(reaction).min(n)]
+                    let offset = c * self.thresholds;
+                    for (thresholds, decided) in &runs {
+                        let start = if *decided != NEVER {
+                            next[(*decided as usize).saturating_add(reaction).min(n)]
                         } else {
                             NEVER
                         };
-                        visit(c * self.thresholds + t, start);
+                        visit(offset + thresholds.start..offset + thresholds.end, start);
                     }
                 }
             }
@@ -267,10 +279,14 @@ impl DriverEstimate {
                 duration_s,
             );
             let misfit = Misfit::new(seen.len(), scene.dt, onset.time_s);
-            grid.for_each_start(&view, |h, start| {
+            grid.for_each_start(&view, |hypotheses, start| {
                 let (error, penalty) = misfit.of(start);
-                worst[h] = worst[h].max(error);
-                log_posterior[h] -= penalty;
+                for far in &mut worst[hypotheses.clone()] {
+                    *far = far.max(error);
+                }
+                for lp in &mut log_posterior[hypotheses] {
+                    *lp -= penalty;
+                }
             });
             scenes += 1;
         }
