@@ -8,6 +8,7 @@
 use std::time::Instant;
 
 use palc_aggregator::Experience;
+use palc_harness::advanced::aggregator_options;
 use palc_harness::user::{Spread, TakeoverCause};
 use palc_harness::{
     CellChoice, HarnessError, LaneChangeRecord, LearnConfig, LearningLoop, LessonEvent, Observer,
@@ -230,6 +231,16 @@ impl Executor for HarnessRuns {
 
     fn cap(&self) -> usize {
         self.base.stopping.max_takeovers
+    }
+
+    /// The run's learning config, with the aggregator options it resolves to
+    /// written out (a rung that names the method's own options runs the method),
+    /// and what the run does with it: one lane change (a drive) or the loop.
+    fn identity(&self, spec: &RunSpec) -> Option<String> {
+        let mut config = self.config(spec).ok()?;
+        config.aggregator = Some(aggregator_options(&config));
+        let driven = (spec.experiment.is_drive(), cap_of(spec, self.cap()));
+        serde_json::to_string(&(config, driven)).ok()
     }
 }
 

@@ -52,6 +52,7 @@ pub mod run_id;
 pub mod runner;
 pub mod scenes;
 pub mod shard;
+pub mod shared_runs;
 pub mod stats;
 pub mod targets;
 pub mod views;

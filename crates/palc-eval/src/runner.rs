@@ -12,6 +12,7 @@ use rayon::prelude::*;
 use crate::EvalError;
 use crate::plan::{Experiment, RunPlan, RunSpec};
 use crate::results::{RunRow, Status};
+use crate::shared_runs::{self, Shared};
 
 /// Runs one spec. The harness implements it (`harness_runs.rs`); tests use
 /// synthetic executors.
@@ -29,6 +30,14 @@ pub trait Executor: Sync {
 
     /// The takeover cap, for rows of runs that could not start.
     fn cap(&self) -> usize;
+
+    /// What determines the result of `spec` apart from the experience it starts
+    /// from: two runs with equal identities and the same source give the same row
+    /// (apart from the spec and the timing fields), so the runner computes one
+    /// and shares it ([`crate::shared_runs`]). `None`, by default: always computed.
+    fn identity(&self, _spec: &RunSpec) -> Option<String> {
+        None
+    }
 }
 
 /// Watches the runs of an evaluation; called from the worker threads.
@@ -73,7 +82,8 @@ pub fn check_jobs(jobs: usize) -> Result<usize, EvalError> {
 }
 
 /// Runs every spec of `plan` on `jobs` threads (at most [`MAX_JOBS`]); the rows
-/// are in plan order.
+/// are in plan order. A run that repeats an earlier one ([`crate::shared_runs`])
+/// is not computed again: it takes the earlier run's row under its own spec.
 pub fn execute<E: Executor>(
     plan: &RunPlan,
     executor: &E,
@@ -84,42 +94,56 @@ pub fn execute<E: Executor>(
         .num_threads(check_jobs(jobs)?)
         .build()?;
     progress.started(plan.len());
+    let original = shared_runs::originals(plan, |spec| executor.identity(spec));
+    let mut shared: Shared<RunRow, E::Experience> = Shared::new(&original);
     // How many runs start from each run's experience: an experience is kept
     // until the last of them has started, then dropped.
     let mut uses: HashMap<usize, usize> = HashMap::new();
     for source in plan.transfer.iter().filter_map(|s| s.experience_from) {
         *uses.entry(source).or_default() += 1;
     }
-    let (mut rows, experiences): (Vec<RunRow>, HashMap<usize, E::Experience>) =
-        pool.install(|| {
-            let done: Vec<(RunRow, Option<E::Experience>)> = plan
-                .first
-                .par_iter()
-                .map(|spec| {
-                    if progress.cancelled() {
-                        return (skipped(spec, executor.cap()), None);
-                    }
-                    let (row, experience) = executor.run(spec, None);
-                    progress.finished(&row);
-                    let keep = uses.contains_key(&spec.id);
-                    (row, experience.filter(|_| keep))
-                })
-                .collect();
-            let mut experiences = HashMap::new();
-            let rows = done
-                .into_iter()
-                .map(|(row, experience)| {
-                    if let Some(experience) = experience {
-                        experiences.insert(row.spec.id, experience);
-                    }
-                    row
-                })
-                .collect();
-            (rows, experiences)
-        });
+    // An original's output, kept whole when a run repeats it.
+    let keep = |id: usize, uses: &HashMap<usize, usize>, shared: &Shared<RunRow, E::Experience>| {
+        uses.contains_key(&id) || shared.has_repeats(id)
+    };
+    let computed: Vec<Option<Output<E>>> = pool.install(|| {
+        (plan.first.par_iter())
+            .map(|spec| {
+                if original[spec.id] != spec.id {
+                    return None;
+                }
+                if progress.cancelled() {
+                    return Some((skipped(spec, executor.cap()), None));
+                }
+                let (row, experience) = executor.run(spec, None);
+                progress.finished(&row);
+                Some((row, experience.filter(|_| keep(spec.id, &uses, &shared))))
+            })
+            .collect()
+    });
+    let mut experiences: HashMap<usize, E::Experience> = HashMap::new();
+    let mut rows = Vec::with_capacity(plan.len());
+    for (spec, output) in plan.first.iter().zip(computed) {
+        let (row, experience) = match output {
+            Some(output) => {
+                shared.keep(spec.id, &output);
+                output
+            }
+            None => {
+                let output = repeated(spec, original[spec.id], &shared);
+                shared.served(original[spec.id]);
+                progress.finished(&output.0);
+                output
+            }
+        };
+        if let Some(experience) = experience.filter(|_| uses.contains_key(&spec.id)) {
+            experiences.insert(spec.id, experience);
+        }
+        rows.push(row);
+    }
     // Runs with experience, in waves: each wave holds the runs whose source has
-    // ended (a grid run, or an accumulation or drive run of an earlier wave).
-    let mut experiences = experiences;
+    // ended (a grid run, or an accumulation or drive run of an earlier wave) and,
+    // for a repeat, whose original has ended.
     let mut transfer: Vec<Option<RunRow>> = vec![None; plan.transfer.len()];
     let offset = plan.first.len();
     let ended = |id: usize, transfer: &[Option<RunRow>]| {
@@ -129,25 +153,28 @@ pub fn execute<E: Executor>(
         let wave: Vec<&RunSpec> = (plan.transfer.iter())
             .filter(|s| transfer[s.id - offset].is_none())
             .filter(|s| s.experience_from.is_none_or(|id| ended(id, &transfer)))
+            .filter(|s| original[s.id] == s.id || ended(original[s.id], &transfer))
             .collect();
         if wave.is_empty() || progress.cancelled() {
             break;
         }
-        let done: Vec<(RunRow, Option<E::Experience>)> = pool.install(|| {
+        let done: Vec<Output<E>> = pool.install(|| {
             wave.par_iter()
                 .map(|spec| {
+                    let compute = |experience: Option<&E::Experience>| match original[spec.id] {
+                        of if of == spec.id => executor.run(spec, experience),
+                        of => repeated(spec, of, &shared),
+                    };
                     let source = spec.experience_from.and_then(|id| experiences.get(&id));
                     let (row, experience) = match (spec.experience_from, source) {
                         (Some(_), Some(experience)) => {
-                            let (row, learned) = executor.run(spec, Some(experience));
+                            let (row, learned) = compute(Some(experience));
                             (row, learned.or_else(|| passed_on(spec, experience)))
                         }
-                        (None, _) => executor.run(spec, None),
+                        (None, _) => compute(None),
                         // A drive that has learned nothing yet (its first
                         // scenes were refused) starts from scratch.
-                        (Some(_), None) if spec.experiment == Experiment::Drive => {
-                            executor.run(spec, None)
-                        }
+                        (Some(_), None) if spec.experiment == Experiment::Drive => compute(None),
                         (Some(source), None) => {
                             let from = (match source.checked_sub(offset) {
                                 None => rows.get(source),
@@ -168,25 +195,34 @@ pub fn execute<E: Executor>(
                         }
                     };
                     progress.finished(&row);
-                    let keep = uses.contains_key(&spec.id);
-                    (row, experience.filter(|_| keep))
+                    (row, experience.filter(|_| keep(spec.id, &uses, &shared)))
                 })
                 .collect()
         });
-        for source in wave.iter().filter_map(|s| s.experience_from) {
-            if let Some(left) = uses.get_mut(&source) {
-                *left -= 1;
-                if *left == 0 {
-                    experiences.remove(&source);
+        for spec in &wave {
+            if let Some(source) = spec.experience_from {
+                if let Some(left) = uses.get_mut(&source) {
+                    *left -= 1;
+                    if *left == 0 {
+                        experiences.remove(&source);
+                    }
                 }
+            }
+            if original[spec.id] != spec.id {
+                shared.served(original[spec.id]);
             }
         }
         for (row, experience) in done {
-            if let Some(experience) = experience {
-                experiences.insert(row.spec.id, experience);
+            let id = row.spec.id;
+            let output = (row, experience);
+            if original[id] == id {
+                shared.keep(id, &output);
             }
-            let index = row.spec.id - offset;
-            transfer[index] = Some(row);
+            let (row, experience) = output;
+            if let Some(experience) = experience.filter(|_| uses.contains_key(&id)) {
+                experiences.insert(id, experience);
+            }
+            transfer[id - offset] = Some(row);
         }
     }
     if progress.cancelled() {
@@ -196,6 +232,35 @@ pub fn execute<E: Executor>(
     progress.done();
     debug_assert!(rows.iter().enumerate().all(|(i, row)| row.spec.id == i));
     Ok(rows)
+}
+
+/// A run's row and the experience it hands on.
+type Output<E> = (RunRow, Option<<E as Executor>::Experience>);
+
+/// The output of a run that repeats original `of`: the original's row under the
+/// run's own spec, and the original's experience. The original has ended.
+fn repeated<X: Clone>(
+    spec: &RunSpec,
+    of: usize,
+    shared: &Shared<RunRow, X>,
+) -> (RunRow, Option<X>) {
+    match shared.output(of) {
+        Some((row, experience)) => (
+            RunRow {
+                spec: spec.clone(),
+                ..row.clone()
+            },
+            experience.clone(),
+        ),
+        // Unreachable: a repeat waits for its original, whose output is kept
+        // until its last repeat is served.
+        None => {
+            let status = Status::Failed {
+                error: format!("the run it repeats (index {of}) has no output"),
+            };
+            (RunRow::without_result(spec.clone(), status, 0, 0.0), None)
+        }
+    }
 }
 
 /// What a run that learned nothing hands on: a drive goes on through a scene it
@@ -324,6 +389,54 @@ pub(crate) mod tests {
     pub(crate) fn synthetic_rows() -> Vec<RunRow> {
         let plan = plan::expand(&plan::tests::selection(), &plan::tests::testbed()).unwrap();
         execute(&plan, &Synthetic, 2, &NoProgress).unwrap()
+    }
+
+    /// [`Synthetic`] with an experience that depends only on what the run computes,
+    /// counting the runs it computes; with `share`, it names what determines a
+    /// run, so that the runner shares repeats.
+    struct Counting {
+        share: bool,
+        computed: std::sync::atomic::AtomicUsize,
+    }
+
+    impl Executor for Counting {
+        type Experience = usize;
+
+        fn run(&self, spec: &RunSpec, experience: Option<&usize>) -> (RunRow, Option<usize>) {
+            self.computed
+                .fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+            let (row, learned) = Synthetic.run(spec, experience);
+            (row, learned.map(|_| 1))
+        }
+
+        fn cap(&self) -> usize {
+            Synthetic.cap()
+        }
+
+        fn identity(&self, spec: &RunSpec) -> Option<String> {
+            self.share.then(|| {
+                let dt = spec.dt.map(f64::to_bits);
+                format!("{:?}", (spec.experiment_cell(), &spec.speed_case.name, dt))
+            })
+        }
+    }
+
+    #[test]
+    fn shared_repeats_give_the_rows_of_computing_every_run() {
+        let plan = plan::expand(&plan::tests::selection(), &plan::tests::testbed()).unwrap();
+        let counting = |share| Counting {
+            share,
+            computed: Default::default(),
+        };
+        let (every, shared) = (counting(false), counting(true));
+        let all = execute(&plan, &every, 2, &NoProgress).unwrap();
+        let once = execute(&plan, &shared, 2, &NoProgress).unwrap();
+        assert_eq!(all, once);
+        let computed = |e: &Counting| e.computed.load(std::sync::atomic::Ordering::SeqCst);
+        assert!(
+            computed(&shared) < computed(&every),
+            "the plan repeats runs (transfer and matrix pairs), computed once"
+        );
     }
 
     /// Cancels once `after` runs have finished, counting the runs finished.

@@ -5,7 +5,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::{
     error::{ZoneError, check_finite},
-    features::{FeatureInput, MAX_FEATURES, features_into},
+    features::{FeatureInput, MAX_FEATURES, features_into, write_checked_features},
     gaussian::Fitted,
     model::ZoneModel,
 };
@@ -298,15 +298,18 @@ fn boundary_on_line(
     let set = model.config().feature_set;
     let [lo, hi] = config.lateral_range;
     let mut buffer = [0.0; MAX_FEATURES];
+    let at_l = |l: f64| FeatureInput {
+        ego_s: scene.ego_s,
+        ego_l: l,
+        ego_speed: scene.ego_speed,
+        preceding: scene.preceding,
+        adjacent: scene.adjacent,
+    };
+    // The scene is checked once, at the lower edge; every other point of the
+    // line differs only in its finite `ego_l`, so it passes the same checks.
+    features_into(set, &at_l(lo), &mut buffer)?;
     let mut log_odds = |l: f64| -> Result<f64, ZoneError> {
-        let input = FeatureInput {
-            ego_s: scene.ego_s,
-            ego_l: l,
-            ego_speed: scene.ego_speed,
-            preceding: scene.preceding,
-            adjacent: scene.adjacent,
-        };
-        features_into(set, &input, &mut buffer)?;
+        write_checked_features(set, &at_l(l), &mut buffer);
         let a = fitted.log_odds(&buffer[..set.dimension()]);
         if a.is_nan() {
             return Err(ZoneError::Overflow {

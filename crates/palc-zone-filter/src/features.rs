@@ -95,6 +95,24 @@ pub fn features_into(
             found: out.len(),
         });
     }
+    if set == FeatureSet::TimeGap {
+        let v = input.ego_speed;
+        check_finite(v, || "ego_speed".to_owned())?;
+        if v <= 0.0 {
+            return Err(ZoneError::NonPositiveSpeed {
+                field: "ego_speed".to_owned(),
+                value: v,
+            });
+        }
+    }
+    write_checked_features(set, input, out);
+    Ok(())
+}
+
+/// The arithmetic of [`features_into`], for an input it has accepted: the zone
+/// projection checks a line's scene once and then varies only the finite `ego_l`.
+#[inline]
+pub(crate) fn write_checked_features(set: FeatureSet, input: &FeatureInput, out: &mut [f64]) {
     let ds_p = input.preceding[0] - input.ego_s;
     let dl_p = input.preceding[1] - input.ego_l;
     let ds_a = input.adjacent[0] - input.ego_s;
@@ -106,17 +124,9 @@ pub fn features_into(
         FeatureSet::NoDistance => out[..4].copy_from_slice(&[ds_p, dl_p, ds_a, dl_a]),
         FeatureSet::TimeGap => {
             let v = input.ego_speed;
-            check_finite(v, || "ego_speed".to_owned())?;
-            if v <= 0.0 {
-                return Err(ZoneError::NonPositiveSpeed {
-                    field: "ego_speed".to_owned(),
-                    value: v,
-                });
-            }
             out[..4].copy_from_slice(&[ds_p / v, dl_p, ds_a / v, dl_a]);
         }
     }
-    Ok(())
 }
 
 /// The features of `input` as a vector of length `set.dimension()` (Eq. 1 or a variant).

@@ -1,5 +1,7 @@
 //! The posterior over start models and the start it predicts in a new scene.
 
+use std::ops::Range;
+
 use palc_aggregator::Onset;
 use palc_user::{Situation, StartModel};
 
@@ -8,6 +10,10 @@ use super::scene::situations;
 
 /// A step index that means "never starts".
 const NEVER: u32 = u32::MAX;
+
+/// Below this, `f64::exp` returns +0 (its smallest subnormal result is at
+/// about -745.13), so a weight this far below the top is 0 without the call.
+const EXP_UNDERFLOW: f64 = -746.0;
 
 /// The grid of start models: every threshold of every cue, crossed with every
 /// reaction and pair of accepted gaps. Hypothesis `h` is threshold
@@ -81,6 +87,15 @@ impl Grid {
     /// have changed lanes before the system planned (palc-user refuses such a
     /// scene for a simulated user).
     fn starts(&self, scene: &SceneView<'_>) -> Vec<u32> {
+        let mut starts = vec![NEVER; self.len()];
+        self.for_each_start(scene, |hypotheses, start| starts[hypotheses].fill(start));
+        starts
+    }
+
+    /// Calls `visit(hypotheses, start)` with every hypothesis once, as [`Grid::starts`]
+    /// lists them, without the list: `hypotheses` are consecutive thresholds of one
+    /// combination that decide at the same step, and so start at the same step.
+    fn for_each_start(&self, scene: &SceneView<'_>, mut visit: impl FnMut(Range<usize>, u32)) {
         let n = scene.situations.len();
         let mut decision = vec![NEVER; self.thresholds];
         for (cue, first, thresholds) in &self.cues {
@@ -99,7 +114,14 @@ impl Grid {
                 }
             }
         }
-        let mut starts = vec![NEVER; self.len()];
+        // The thresholds in runs of the same decision step.
+        let mut runs: Vec<(Range<usize>, u32)> = Vec::new();
+        for (t, &decided) in decision.iter().enumerate() {
+            match runs.last_mut() {
+                Some((range, step)) if *step == decided => range.end = t + 1,
+                _ => runs.push((t..t + 1, decided)),
+            }
+        }
         let mut next = vec![NEVER; n + 1];
         for (lead_index, &lead) in LEAD_GAPS_S.iter().enumerate() {
             for (lag_index, &lag) in LAG_GAPS_S.iter().enumerate() {
@@ -115,16 +137,18 @@ impl Grid {
                 for (reaction_index, &reaction_s) in REACTIONS_S.iter().enumerate() {
                     let reaction = StartModel { reaction_s, ..gaps }.reaction_steps(scene.dt);
                     let c = combination_index(reaction_index, lead_index, lag_index);
-                    let out = &mut starts[c * self.thresholds..(c + 1) * self.thresholds];
-                    for (start, &decided) in out.iter_mut().zip(&decision) {
-                        if decided != NEVER {
-                            *start = next[(decided as usize).saturating_add(reaction).min(n)];
-                        }
+                    let offset = c * self.thresholds;
+                    for (thresholds, decided) in &runs {
+                        let start = if *decided != NEVER {
+                            next[(*decided as usize).saturating_add(reaction).min(n)]
+                        } else {
+                            NEVER
+                        };
+                        visit(offset + thresholds.start..offset + thresholds.end, start);
                     }
                 }
             }
         }
-        starts
     }
 }
 
@@ -181,6 +205,35 @@ impl<'a> SceneView<'a> {
     }
 }
 
+/// How far each start step of a scene lies from the observed start, and the
+/// log-likelihood it costs: computed once per step (a scene has a few hundred)
+/// rather than once per hypothesis (a million), with the same arithmetic.
+struct Misfit {
+    /// `(error_s, penalty)` per start step; the last entry is for [`NEVER`].
+    per_step: Vec<(f64, f64)>,
+}
+
+impl Misfit {
+    /// The misfits of the `steps` start steps of a scene at step `dt` whose
+    /// observed start is `observed_s`.
+    fn new(steps: usize, dt: f64, observed_s: f64) -> Misfit {
+        let penalty = |error: f64| 0.5 * (error / OBSERVATION_SD_S).powi(2);
+        let per_step = (0..steps)
+            .map(|step| (f64::from(step as u32) * dt - observed_s).abs())
+            .chain([f64::INFINITY])
+            .map(|error| (error, penalty(error)))
+            .collect();
+        Misfit { per_step }
+    }
+
+    /// The error (s) and penalty of a start at `start` ([`NEVER`] for none).
+    #[inline]
+    fn of(&self, start: u32) -> (f64, f64) {
+        let last = self.per_step.len() - 1;
+        self.per_step[(start as usize).min(last)]
+    }
+}
+
 /// What the estimate predicts in a scene.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Prediction {
@@ -225,16 +278,16 @@ impl DriverEstimate {
                 safe.as_deref(),
                 duration_s,
             );
-            let starts = grid.starts(&view);
-            for ((lp, far), &start) in log_posterior.iter_mut().zip(&mut worst).zip(&starts) {
-                let error = if start == NEVER {
-                    f64::INFINITY
-                } else {
-                    (f64::from(start) * scene.dt - onset.time_s).abs()
-                };
-                *far = far.max(error);
-                *lp -= 0.5 * (error / OBSERVATION_SD_S).powi(2);
-            }
+            let misfit = Misfit::new(seen.len(), scene.dt, onset.time_s);
+            grid.for_each_start(&view, |hypotheses, start| {
+                let (error, penalty) = misfit.of(start);
+                for far in &mut worst[hypotheses.clone()] {
+                    *far = far.max(error);
+                }
+                for lp in &mut log_posterior[hypotheses] {
+                    *lp -= penalty;
+                }
+            });
             scenes += 1;
         }
         if scenes == 0 {
@@ -327,19 +380,25 @@ impl DriverEstimate {
 
     /// The posterior mass of each cue.
     pub fn cue_masses(&self) -> Vec<(&'static str, f64)> {
-        let weights = self.weights();
-        let total: f64 = weights.iter().sum();
+        let top = self.top();
         let nt = self.grid.thresholds;
-        (self.grid.cues.iter())
-            .map(|(cue, first, thresholds)| {
-                let mass: f64 = (0..Grid::combinations())
-                    .flat_map(|c| {
-                        let start = c * nt + first;
-                        weights[start..start + thresholds.len()].iter()
-                    })
-                    .sum();
-                (cue.name(), if total > 0.0 { mass / total } else { 0.0 })
-            })
+        // One pass in hypothesis order: the total and each cue's mass add their
+        // weights in the order of a sum over the weights (the cues' thresholds
+        // are consecutive, in the order of the cues).
+        let mut total = -0.0;
+        let mut masses = vec![-0.0; self.grid.cues.len()];
+        for c in 0..Grid::combinations() {
+            for ((_, first, thresholds), mass) in self.grid.cues.iter().zip(&mut masses) {
+                let start = c * nt + first;
+                for &lp in &self.log_posterior[start..start + thresholds.len()] {
+                    let weight = weight(lp, top);
+                    total += weight;
+                    *mass += weight;
+                }
+            }
+        }
+        (self.grid.cues.iter().zip(masses))
+            .map(|((cue, _, _), mass)| (cue.name(), if total > 0.0 { mass / total } else { 0.0 }))
             .collect()
     }
 
@@ -366,18 +425,23 @@ impl DriverEstimate {
         }
     }
 
-    /// The posterior weights, scaled so that the largest is 1.
-    fn weights(&self) -> Vec<f64> {
-        let top = (self.log_posterior.iter().copied()).fold(f64::NEG_INFINITY, f64::max);
-        (self.log_posterior.iter())
-            .map(|&lp| {
-                if top.is_finite() {
-                    (lp - top).exp()
-                } else {
-                    0.0
-                }
-            })
-            .collect()
+    /// The largest log posterior.
+    fn top(&self) -> f64 {
+        (self.log_posterior.iter().copied()).fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
+/// The posterior weight of a hypothesis of log posterior `lp`, scaled so that
+/// the largest (`top`) is 1.
+#[inline]
+fn weight(lp: f64, top: f64) -> f64 {
+    let below_top = lp - top;
+    // `exp` is exactly +0 below its underflow (about -745.13): the many
+    // hypotheses far from the top skip the call.
+    if !top.is_finite() || below_top < EXP_UNDERFLOW {
+        0.0
+    } else {
+        below_top.exp()
     }
 }
 
