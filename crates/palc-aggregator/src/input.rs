@@ -87,7 +87,8 @@ pub fn read_to_string(path: &Path) -> Result<String, InputError> {
     })
 }
 
-/// [`read`] with another bound (for tests of the bound itself).
+/// [`read`] with another bound (for tests of the bound itself, and for inputs
+/// that are outputs of palc, such as an evaluation shard's runs).
 ///
 /// # Errors
 /// [`InputError`] naming `path`.

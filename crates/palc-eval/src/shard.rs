@@ -268,12 +268,20 @@ pub fn merge_rows(
     Ok((rows.into_iter().flatten().collect(), wall_s, threads))
 }
 
+/// The most bytes read from one shard's file (2 GiB). A shard holds its runs
+/// with every lane change, about 9 kB a run: a quarter of the full reproduction
+/// (11,400 runs) is 100 MB, past the 64 MiB every other input is held to
+/// (`palc_aggregator::input::MAX_INPUT_BYTES`). 2 GiB is about 230,000 runs a
+/// shard, which the merge still holds in memory.
+pub const MAX_SHARD_BYTES: u64 = 2 * 1024 * 1024 * 1024;
+
 fn read(path: &Path) -> Result<ShardFile, EvalError> {
-    let bytes = palc_aggregator::input::read(path).map_err(|e| EvalError::Io {
-        action: "read",
-        path: path.to_owned(),
-        source: e.into_io(),
-    })?;
+    let bytes =
+        palc_aggregator::input::read_bounded(path, MAX_SHARD_BYTES).map_err(|e| EvalError::Io {
+            action: "read",
+            path: path.to_owned(),
+            source: e.into_io(),
+        })?;
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(&bytes);
     serde_json::from_slice(bytes).map_err(|e| shard_error(path, format!("not a shard file: {e}")))
 }
