@@ -129,6 +129,9 @@ pub fn execute<E: Executor>(
                 shared.keep(spec.id, &output);
                 output
             }
+            // A cancelled evaluation reports no repeat as finished: its
+            // original was skipped, and nothing is written.
+            None if progress.cancelled() => (skipped(spec, executor.cap()), None),
             None => {
                 let output = repeated(spec, original[spec.id], &shared);
                 shared.served(original[spec.id]);
@@ -471,6 +474,44 @@ pub(crate) mod tests {
         // On one thread, the run that made the count reach 3 is the last one started.
         let finished = progress.finished.load(std::sync::atomic::Ordering::SeqCst);
         assert_eq!(finished, 3);
+    }
+
+    /// Repeats every run of a cell (any experiment, step or margin) as its first.
+    struct RepeatsCells;
+
+    impl Executor for RepeatsCells {
+        type Experience = usize;
+
+        fn run(&self, spec: &RunSpec, experience: Option<&usize>) -> (RunRow, Option<usize>) {
+            Synthetic.run(spec, experience)
+        }
+
+        fn cap(&self) -> usize {
+            Synthetic.cap()
+        }
+
+        fn identity(&self, spec: &RunSpec) -> Option<String> {
+            Some(format!("{:?}", spec.experiment_cell()))
+        }
+    }
+
+    #[test]
+    fn a_cancelled_evaluation_reports_no_repeat_as_finished() {
+        let plan = plan::expand(&plan::tests::selection(), &plan::tests::testbed()).unwrap();
+        let original = shared_runs::originals(&plan, |spec| RepeatsCells.identity(spec));
+        let first = plan.first.len();
+        assert!(
+            (0..first).any(|i| original[i] != i),
+            "the test needs a repeat among the runs without experience"
+        );
+        let progress = CancelAfter {
+            after: 0,
+            finished: Default::default(),
+        };
+        let result = execute(&plan, &RepeatsCells, 1, &progress);
+        assert!(matches!(result, Err(EvalError::Cancelled)), "{result:?}");
+        let finished = progress.finished.load(std::sync::atomic::Ordering::SeqCst);
+        assert_eq!(finished, 0);
     }
 
     #[test]
