@@ -105,9 +105,9 @@ pub enum EvalError {
         /// The cause.
         source: palc_harness::HarnessError,
     },
-    /// The worker threads could not start.
-    #[error("cannot start the thread pool: {0}")]
-    ThreadPool(#[from] rayon::ThreadPoolBuildError),
+    /// A worker thread could not start.
+    #[error("cannot start a worker thread: {0}")]
+    Thread(std::io::Error),
     /// Results could not be serialized.
     #[error("cannot serialize the results: {0}")]
     Json(#[from] serde_json::Error),

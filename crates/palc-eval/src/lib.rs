@@ -51,6 +51,7 @@ pub mod results;
 pub mod run_id;
 pub mod runner;
 pub mod scenes;
+pub mod schedule;
 pub mod shard;
 pub mod shared_runs;
 pub mod stats;

@@ -1,17 +1,19 @@
-//! Running the plan in parallel: rayon on a fixed number of threads, results
-//! collected by run index so that every output is the same whatever the number
-//! of threads.
+//! Running the plan in parallel: a fixed number of threads take the runs in the
+//! order of [`crate::schedule`] (each run as soon as the runs it needs have
+//! ended), and the results are collected by run index, so that every output is
+//! the same whatever the number of threads and the order runs end in.
 //!
 //! The runner prints nothing: it reports each finished run to a [`Progress`],
 //! which a binary turns into a progress bar or log lines.
 
 use std::collections::HashMap;
-
-use rayon::prelude::*;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard, PoisonError};
 
 use crate::EvalError;
 use crate::plan::{Experiment, RunPlan, RunSpec};
 use crate::results::{RunRow, Status};
+use crate::schedule::Schedule;
 use crate::shared_runs::{self, Shared};
 
 /// Runs one spec. The harness implements it (`harness_runs.rs`); tests use
@@ -82,164 +84,251 @@ pub fn check_jobs(jobs: usize) -> Result<usize, EvalError> {
 }
 
 /// Runs every spec of `plan` on `jobs` threads (at most [`MAX_JOBS`]); the rows
-/// are in plan order. A run that repeats an earlier one ([`crate::shared_runs`])
-/// is not computed again: it takes the earlier run's row under its own spec.
+/// are in plan order. Each run starts as soon as the runs it needs have ended
+/// and a thread is free, the longest chain first ([`crate::schedule`]). A run
+/// that repeats an earlier one ([`crate::shared_runs`]) is not computed again:
+/// it takes the earlier run's row under its own spec.
 pub fn execute<E: Executor>(
     plan: &RunPlan,
     executor: &E,
     jobs: usize,
     progress: &dyn Progress,
 ) -> Result<Vec<RunRow>, EvalError> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(check_jobs(jobs)?)
-        .build()?;
+    let jobs = check_jobs(jobs)?;
     progress.started(plan.len());
     let original = shared_runs::originals(plan, |spec| executor.identity(spec));
-    let mut shared: Shared<RunRow, E::Experience> = Shared::new(&original);
     // How many runs start from each run's experience: an experience is kept
     // until the last of them has started, then dropped.
     let mut uses: HashMap<usize, usize> = HashMap::new();
-    for source in plan.transfer.iter().filter_map(|s| s.experience_from) {
+    for source in plan.all().filter_map(|s| s.experience_from) {
         *uses.entry(source).or_default() += 1;
     }
-    // An original's output, kept whole when a run repeats it.
-    let keep = |id: usize, uses: &HashMap<usize, usize>, shared: &Shared<RunRow, E::Experience>| {
-        uses.contains_key(&id) || shared.has_repeats(id)
-    };
-    let computed: Vec<Option<Output<E>>> = pool.install(|| {
-        (plan.first.par_iter())
-            .map(|spec| {
-                if original[spec.id] != spec.id {
-                    return None;
-                }
-                if progress.cancelled() {
-                    return Some((skipped(spec, executor.cap()), None));
-                }
-                let (row, experience) = executor.run(spec, None);
-                progress.finished(&row);
-                Some((row, experience.filter(|_| keep(spec.id, &uses, &shared))))
-            })
-            .collect()
+    let specs: Vec<&RunSpec> = plan.all().collect();
+    let state = Mutex::new(State {
+        schedule: Schedule::new(plan, &original),
+        shared: Shared::new(&original),
+        rows: vec![None; plan.len()],
+        experiences: HashMap::new(),
+        uses,
+        running: 0,
     });
-    let mut experiences: HashMap<usize, E::Experience> = HashMap::new();
-    let mut rows = Vec::with_capacity(plan.len());
-    for (spec, output) in plan.first.iter().zip(computed) {
-        let (row, experience) = match output {
-            Some(output) => {
-                shared.keep(spec.id, &output);
-                output
-            }
-            // A cancelled evaluation reports no repeat as finished: its
-            // original was skipped, and nothing is written.
-            None if progress.cancelled() => (skipped(spec, executor.cap()), None),
-            None => {
-                let output = repeated(spec, original[spec.id], &shared);
-                shared.served(original[spec.id]);
-                progress.finished(&output.0);
-                output
-            }
-        };
-        if let Some(experience) = experience.filter(|_| uses.contains_key(&spec.id)) {
-            experiences.insert(spec.id, experience);
-        }
-        rows.push(row);
-    }
-    // Runs with experience, in waves: each wave holds the runs whose source has
-    // ended (a grid run, or an accumulation or drive run of an earlier wave) and,
-    // for a repeat, whose original has ended.
-    let mut transfer: Vec<Option<RunRow>> = vec![None; plan.transfer.len()];
-    let offset = plan.first.len();
-    let ended = |id: usize, transfer: &[Option<RunRow>]| {
-        id < offset || transfer.get(id - offset).is_some_and(Option::is_some)
+    let changed = Condvar::new();
+    let work = Work {
+        specs: &specs,
+        original: &original,
+        executor,
+        progress,
+        state: &state,
+        changed: &changed,
     };
-    loop {
-        let wave: Vec<&RunSpec> = (plan.transfer.iter())
-            .filter(|s| transfer[s.id - offset].is_none())
-            .filter(|s| s.experience_from.is_none_or(|id| ended(id, &transfer)))
-            .filter(|s| original[s.id] == s.id || ended(original[s.id], &transfer))
-            .collect();
-        if wave.is_empty() || progress.cancelled() {
-            break;
-        }
-        let done: Vec<Output<E>> = pool.install(|| {
-            wave.par_iter()
-                .map(|spec| {
-                    let compute = |experience: Option<&E::Experience>| match original[spec.id] {
-                        of if of == spec.id => executor.run(spec, experience),
-                        of => repeated(spec, of, &shared),
-                    };
-                    let source = spec.experience_from.and_then(|id| experiences.get(&id));
-                    let (row, experience) = match (spec.experience_from, source) {
-                        (Some(_), Some(experience)) => {
-                            let (row, learned) = compute(Some(experience));
-                            (row, learned.or_else(|| passed_on(spec, experience)))
-                        }
-                        (None, _) => compute(None),
-                        // A drive that has learned nothing yet (its first
-                        // scenes were refused) starts from scratch.
-                        (Some(_), None) if spec.experiment == Experiment::Drive => compute(None),
-                        (Some(source), None) => {
-                            let from = (match source.checked_sub(offset) {
-                                None => rows.get(source),
-                                Some(i) => transfer.get(i).and_then(Option::as_ref),
-                            })
-                            .map_or_else(|| "none".to_owned(), RunSpec::label_of);
-                            let reason = format!("no experience to start from: source run {from}");
-                            let row = RunRow::without_result(
-                                (*spec).clone(),
-                                Status::Refused {
-                                    reason,
-                                    refusal: None,
-                                },
-                                executor.cap(),
-                                0.0,
-                            );
-                            (row, None)
-                        }
-                    };
-                    progress.finished(&row);
-                    (row, experience.filter(|_| keep(spec.id, &uses, &shared)))
-                })
-                .collect()
-        });
-        for spec in &wave {
-            if let Some(source) = spec.experience_from {
-                if let Some(left) = uses.get_mut(&source) {
-                    *left -= 1;
-                    if *left == 0 {
-                        experiences.remove(&source);
-                    }
-                }
-            }
-            if original[spec.id] != spec.id {
-                shared.served(original[spec.id]);
+    // Fewer threads than asked still run every run; none is an error.
+    let none_started = std::thread::scope(|scope| {
+        let mut error = None;
+        let mut started = 0;
+        for _ in 0..jobs {
+            let thread = std::thread::Builder::new().name("palc-eval".to_owned());
+            match thread.spawn_scoped(scope, || work.run_until_done()) {
+                Ok(_) => started += 1,
+                Err(e) => error = Some(e),
             }
         }
-        for (row, experience) in done {
-            let id = row.spec.id;
-            let output = (row, experience);
-            if original[id] == id {
-                shared.keep(id, &output);
-            }
-            let (row, experience) = output;
-            if let Some(experience) = experience.filter(|_| uses.contains_key(&id)) {
-                experiences.insert(id, experience);
-            }
-            transfer[id - offset] = Some(row);
-        }
+        error.filter(|_| started == 0)
+    });
+    if let Some(error) = none_started {
+        return Err(EvalError::Thread(error));
     }
     if progress.cancelled() {
         return Err(EvalError::Cancelled);
     }
-    rows.extend(transfer.into_iter().flatten());
+    let rows = state
+        .into_inner()
+        .unwrap_or_else(PoisonError::into_inner)
+        .rows;
+    let rows: Vec<RunRow> = (rows.into_iter().zip(&specs))
+        .map(|(row, spec)| row.unwrap_or_else(|| never_ready(spec, executor.cap())))
+        .collect();
     progress.done();
     debug_assert!(rows.iter().enumerate().all(|(i, row)| row.spec.id == i));
     Ok(rows)
 }
 
-/// A run's row and the experience it hands on.
-type Output<E> = (RunRow, Option<<E as Executor>::Experience>);
+/// What the threads share: the schedule and every output so far.
+struct State<X> {
+    schedule: Schedule,
+    /// Outputs of originals that repeats still wait for.
+    shared: Shared<RunRow, Arc<X>>,
+    /// The row of every run that has ended, by run index.
+    rows: Vec<Option<RunRow>>,
+    /// Experiences that runs not yet started will start from, by run index.
+    experiences: HashMap<usize, Arc<X>>,
+    /// How many runs not yet started will start from each run's experience.
+    uses: HashMap<usize, usize>,
+    /// Runs started and not ended.
+    running: usize,
+}
 
+/// What a run starts with, taken from the [`State`] when it starts.
+enum Start<X> {
+    /// Compute the run, from the experience of its source if it has one.
+    Compute { source: Option<Source<X>> },
+    /// Take the output of the original it repeats.
+    Repeat(Box<(RunRow, Option<Arc<X>>)>),
+}
+
+/// The run a run starts from: its experience, or its row when it left none.
+enum Source<X> {
+    Experience(Arc<X>),
+    Nothing { label: String },
+}
+
+/// One evaluation's runs, worked on by every thread.
+struct Work<'a, E: Executor> {
+    specs: &'a [&'a RunSpec],
+    original: &'a [usize],
+    executor: &'a E,
+    progress: &'a dyn Progress,
+    state: &'a Mutex<State<E::Experience>>,
+    changed: &'a Condvar,
+}
+
+impl<E: Executor> Work<'_, E> {
+    /// Starts ready runs until none is left to start (or the evaluation is
+    /// cancelled), waiting while runs that others need are running.
+    fn run_until_done(&self) {
+        while let Some((id, start)) = self.next_start() {
+            let spec = self.specs[id];
+            let (row, experience) = match start {
+                Start::Repeat(output) => *output,
+                Start::Compute { source } => self.compute(spec, source),
+            };
+            self.progress.finished(&row);
+            self.end(id, row, experience);
+        }
+        // Wake the threads that wait, to see that nothing is left.
+        self.changed.notify_all();
+    }
+
+    /// The next run to start, and what it starts with; `None` when every run
+    /// has started and none is running, or when the evaluation is cancelled.
+    fn next_start(&self) -> Option<(usize, Start<E::Experience>)> {
+        let mut state = self.lock();
+        let id = loop {
+            if self.progress.cancelled() {
+                return None;
+            }
+            if let Some(id) = state.schedule.next_ready() {
+                break id;
+            }
+            if state.running == 0 {
+                return None;
+            }
+            state = (self.changed.wait(state)).unwrap_or_else(PoisonError::into_inner);
+        };
+        state.running += 1;
+        let spec = self.specs[id];
+        let of = self.original[id];
+        if of != id {
+            let output = repeated(spec, of, &state.shared);
+            state.shared.served(of);
+            return Some((id, Start::Repeat(Box::new(output))));
+        }
+        let source = spec.experience_from.map(|source| {
+            let experience = state.experiences.get(&source).cloned();
+            if let Some(left) = state.uses.get_mut(&source) {
+                *left -= 1;
+                if *left == 0 {
+                    state.uses.remove(&source);
+                    state.experiences.remove(&source);
+                }
+            }
+            match experience {
+                Some(experience) => Source::Experience(experience),
+                None => Source::Nothing {
+                    label: (state.rows.get(source).and_then(Option::as_ref))
+                        .map_or_else(|| "none".to_owned(), RunSpec::label_of),
+                },
+            }
+        });
+        Some((id, Start::Compute { source }))
+    }
+
+    /// Computes `spec` from its source.
+    fn compute(
+        &self,
+        spec: &RunSpec,
+        source: Option<Source<E::Experience>>,
+    ) -> (RunRow, Option<Arc<E::Experience>>) {
+        // A run that panics fails alone: the other threads, waiting for it to
+        // end, go on, and its row names the panic.
+        let run = |experience: Option<&E::Experience>| match catch_unwind(AssertUnwindSafe(|| {
+            self.executor.run(spec, experience)
+        })) {
+            Ok((row, learned)) => (row, learned.map(Arc::new)),
+            Err(panic) => {
+                let message = (panic.downcast_ref::<&str>().map(|m| (*m).to_owned()))
+                    .or_else(|| panic.downcast_ref::<String>().cloned())
+                    .unwrap_or_else(|| "no message".to_owned());
+                let status = Status::Failed {
+                    error: format!("the run panicked: {message}"),
+                };
+                let row = RunRow::without_result(spec.clone(), status, self.executor.cap(), 0.0);
+                (row, None)
+            }
+        };
+        match source {
+            None => run(None),
+            Some(Source::Experience(experience)) => {
+                let (row, learned) = run(Some(&experience));
+                (row, learned.or_else(|| passed_on(spec, &experience)))
+            }
+            // A drive that has learned nothing yet (its first scenes were
+            // refused) starts from scratch.
+            Some(Source::Nothing { .. }) if spec.experiment == Experiment::Drive => run(None),
+            Some(Source::Nothing { label }) => {
+                let reason = format!("no experience to start from: source run {label}");
+                let status = Status::Refused {
+                    reason,
+                    refusal: None,
+                };
+                let row = RunRow::without_result(spec.clone(), status, self.executor.cap(), 0.0);
+                (row, None)
+            }
+        }
+    }
+
+    /// Records the output of run `id` and makes ready the runs that need it.
+    fn end(&self, id: usize, row: RunRow, experience: Option<Arc<E::Experience>>) {
+        let mut state = self.lock();
+        let output = (row, experience);
+        if self.original[id] == id {
+            state.shared.keep(id, &output);
+        }
+        let (row, experience) = output;
+        if let Some(experience) = experience.filter(|_| state.uses.contains_key(&id)) {
+            state.experiences.insert(id, experience);
+        }
+        state.rows[id] = Some(row);
+        state.schedule.ended(id);
+        state.running -= 1;
+        drop(state);
+        self.changed.notify_all();
+    }
+
+    fn lock(&self) -> MutexGuard<'_, State<E::Experience>> {
+        // A thread that panicked inside the lock left the state as it was
+        // between two runs: the others go on.
+        self.state.lock().unwrap_or_else(PoisonError::into_inner)
+    }
+}
+
+/// The row of a run that never became ready. Unreachable: a run needs only
+/// earlier runs of the plan, which all end.
+fn never_ready(spec: &RunSpec, cap: usize) -> RunRow {
+    let status = Status::Failed {
+        error: "a run it needs never ended".to_owned(),
+    };
+    RunRow::without_result(spec.clone(), status, cap, 0.0)
+}
 /// The output of a run that repeats original `of`: the original's row under the
 /// run's own spec, and the original's experience. The original has ended.
 fn repeated<X: Clone>(
@@ -270,14 +359,6 @@ fn repeated<X: Clone>(
 /// could not drive (refused) with the experience it had; other runs hand on nothing.
 fn passed_on<X: Clone>(spec: &RunSpec, experience: &X) -> Option<X> {
     (spec.experiment == Experiment::Drive).then(|| experience.clone())
-}
-
-/// The row of a run skipped because the evaluation was cancelled; never written.
-fn skipped(spec: &RunSpec, cap: usize) -> RunRow {
-    let status = Status::Failed {
-        error: "cancelled".to_owned(),
-    };
-    RunRow::without_result(spec.clone(), status, cap, 0.0)
 }
 
 impl RunSpec {
@@ -512,6 +593,52 @@ pub(crate) mod tests {
         assert!(matches!(result, Err(EvalError::Cancelled)), "{result:?}");
         let finished = progress.finished.load(std::sync::atomic::Ordering::SeqCst);
         assert_eq!(finished, 0);
+    }
+
+    /// [`Synthetic`], but panics in the first run of the transfer phase.
+    struct PanicsOnce {
+        at: usize,
+    }
+
+    impl Executor for PanicsOnce {
+        type Experience = usize;
+
+        fn run(&self, spec: &RunSpec, experience: Option<&usize>) -> (RunRow, Option<usize>) {
+            assert!(spec.id != self.at, "a bug in run {}", spec.id);
+            Synthetic.run(spec, experience)
+        }
+
+        fn cap(&self) -> usize {
+            Synthetic.cap()
+        }
+    }
+
+    #[test]
+    fn a_run_that_panics_fails_alone_and_names_the_panic() {
+        let plan = plan::expand(&plan::tests::selection(), &plan::tests::testbed()).unwrap();
+        let at = plan.first.len();
+        let rows = execute(&plan, &PanicsOnce { at }, 2, &NoProgress).unwrap();
+        let every = execute(&plan, &Synthetic, 2, &NoProgress).unwrap();
+        assert_eq!(rows.len(), plan.len());
+        match &rows[at].status {
+            Status::Failed { error } => {
+                assert!(error.contains("panicked: a bug in run"), "{error}")
+            }
+            other => panic!("expected a failed run, got {other:?}"),
+        }
+        // Runs that do not learn from it, directly or down a chain, are as
+        // without the panic.
+        let mut affected = vec![false; plan.len()];
+        affected[at] = true;
+        for spec in plan.all() {
+            affected[spec.id] |= spec.experience_from.is_some_and(|s| affected[s]);
+        }
+        assert!(affected.iter().filter(|&&a| !a).count() > plan.len() / 2);
+        for (row, expected) in rows.iter().zip(&every) {
+            if !affected[row.spec.id] {
+                assert_eq!(row, expected);
+            }
+        }
     }
 
     #[test]
