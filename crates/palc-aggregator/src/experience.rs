@@ -6,7 +6,7 @@ use palc_planner::Weights;
 use palc_zone_filter::ZoneModel;
 use serde::{Deserialize, Serialize};
 
-use crate::{AggregatorError, ApprenticeshipState, Onset, resample_weights};
+use crate::{AggregatorError, ApprenticeshipState, Onset, OwnLaneChange, resample_weights};
 
 /// The experience format version this build writes and the newest it reads.
 /// Version 2 adds the scene each onset was observed in ([`crate::SceneSteps`]);
@@ -41,8 +41,8 @@ pub struct ExperienceMetadata {
 /// matrix, the apprenticeship state, the user's observed starts and metadata.
 ///
 /// Saved as JSON `{format_version, metadata, weights, zone, apprenticeship,
-/// anchor_s, onsets, demonstration}` (the last three may be absent in older
-/// files); the
+/// anchor_s, onsets, demonstration, own_lane_change}` (the last four may be
+/// absent in older files); the
 /// zone is the zone filter's own versioned serialization. Numbers round-trip
 /// bit-exactly (shortest representation on write, correctly rounded parse).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -67,6 +67,9 @@ pub struct Experience {
     /// weights' time base (step `metadata.dt`): what the user was seen to drive,
     /// which a new scene can rehearse. `None` before the first lesson.
     pub demonstration: Option<Vec<f64>>,
+    /// The user's own lane change as last seen whole, from rest in its lane to
+    /// its end, when a lesson showed it; `None` otherwise and in older files.
+    pub own_lane_change: Option<OwnLaneChange>,
 }
 
 /// The file layout: the version first, so that a reader sees it before anything else.
@@ -84,6 +87,8 @@ struct Stored {
     onsets: Vec<Onset>,
     #[serde(default)]
     demonstration: Option<Vec<f64>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    own_lane_change: Option<OwnLaneChange>,
 }
 
 #[derive(Deserialize)]
@@ -120,6 +125,7 @@ impl Experience {
             anchor_s: None,
             onsets: Vec::new(),
             demonstration: None,
+            own_lane_change: None,
         };
         experience.validate()?;
         Ok(experience)
@@ -136,7 +142,8 @@ impl Experience {
     /// [`EXPERIENCE_DT_BOUNDS_S`], at most [`palc_planner::MAX_HORIZON`] weight
     /// columns, finite numbers, the anchor inside the weights' time base, the
     /// demonstration no longer than the weights and within
-    /// [`MAX_DEMONSTRATION_OFFSET_M`], the onsets in their ranges.
+    /// [`MAX_DEMONSTRATION_OFFSET_M`], the onsets in their ranges, the user's own
+    /// lane change from 0 to 1 ([`OwnLaneChange::validate`]).
     pub fn validate(&self) -> Result<(), AggregatorError> {
         let out_of_range = |field: String, value: f64, bound: String| AggregatorError::OutOfRange {
             field,
@@ -213,6 +220,9 @@ impl Experience {
         for (i, onset) in self.onsets.iter().enumerate() {
             onset.validate(i)?;
         }
+        if let Some(own) = &self.own_lane_change {
+            own.validate()?;
+        }
         for (i, &l) in self.demonstration.iter().flatten().enumerate() {
             if !l.is_finite() {
                 return Err(AggregatorError::NonFinite {
@@ -261,6 +271,7 @@ impl Experience {
             anchor_s: self.anchor_s,
             onsets: self.onsets.clone(),
             demonstration: self.demonstration.clone(),
+            own_lane_change: self.own_lane_change.clone(),
         };
         let mut bytes =
             serde_json::to_vec_pretty(&stored).map_err(|e| AggregatorError::Serialize {
@@ -322,6 +333,7 @@ impl Experience {
             anchor_s: stored.anchor_s,
             onsets: stored.onsets,
             demonstration: stored.demonstration,
+            own_lane_change: stored.own_lane_change,
         };
         experience.validate().map_err(|e| corrupt(e.to_string()))?;
         // A file steers the planner: its weights must pass the planner's own

@@ -82,6 +82,7 @@ mod lesson;
 mod onset;
 mod options;
 pub mod output;
+mod own_lane_change;
 mod resample;
 mod rows;
 mod scale;
@@ -106,6 +107,9 @@ pub use expert::{ExpertGenerator, ExpertInput, ExpertKind, LessonExpert, ZoneCen
 pub use lesson::Lesson;
 pub use onset::{Onset, SceneSteps, SeenStep};
 pub use options::{AggregatorOptions, Representation};
+pub use own_lane_change::{
+    MAX_OWN_LANE_CHANGE_SAMPLES, MIN_OWN_LANE_CHANGE_SAMPLES, OwnLaneChange,
+};
 pub use resample::{resample_weights, resample_weights_shifted};
 pub use rows::LearnableRows;
 pub use scale::{FeatureScale, feature_error};

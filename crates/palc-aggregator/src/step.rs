@@ -236,6 +236,7 @@ pub fn learn_from_lesson(
             anchor_s: experience.anchor_s,
             onsets: experience.onsets.clone(),
             demonstration: Some(expert.states.iter().map(|x| x.l).collect()),
+            own_lane_change: experience.own_lane_change.clone(),
         },
         expert,
         plan,

@@ -9,7 +9,7 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use palc_aggregator::{
     AggregatorError, ApprenticeshipState, EXPERIENCE_DT_BOUNDS_S, EXPERIENCE_FORMAT_VERSION,
-    Experience, MAX_DEMONSTRATION_OFFSET_M, Onset,
+    Experience, MAX_DEMONSTRATION_OFFSET_M, Onset, OwnLaneChange,
 };
 use palc_planner::{FEATURE_COUNT, Features, Weights, feature};
 use palc_zone_filter::{Label, Sample, ZoneConfig, ZoneModel};
@@ -292,6 +292,30 @@ fn a_file_without_onsets_loads_with_none() {
     experience.onsets.clear();
     experience.demonstration = None;
     assert_eq!(loaded, experience);
+}
+
+#[test]
+fn the_users_own_lane_change_round_trips_and_a_bad_one_is_refused_on_load() {
+    let dir = scratch();
+    let path = dir.join("own.json");
+    let mut experience = sample_experience();
+    experience.own_lane_change = Some(OwnLaneChange {
+        progress: vec![0.0, 0.02, 0.3, 0.81, 1.0],
+    });
+    experience.save(&path).unwrap();
+    assert_eq!(Experience::load(&path).unwrap(), experience);
+    // Edited to turn back: refused on load, naming the sample and the bound.
+    let mut json: serde_json::Value = serde_json::from_slice(&fs::read(&path).unwrap()).unwrap();
+    json["own_lane_change"]["progress"][3] = serde_json::json!(0.1);
+    fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+    let message = Experience::load(&path).unwrap_err().to_string();
+    assert!(message.contains("own_lane_change.progress[3]"), "{message}");
+    assert!(message.contains("never turns back"), "{message}");
+    // A file without it (every file before it existed) loads with none.
+    json.as_object_mut().unwrap().remove("own_lane_change");
+    fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+    assert_eq!(Experience::load(&path).unwrap().own_lane_change, None);
+    fs::remove_dir_all(&dir).unwrap();
 }
 
 #[test]

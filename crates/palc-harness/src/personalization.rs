@@ -15,12 +15,12 @@
 use std::cell::OnceCell;
 use std::fmt;
 
-use palc_aggregator::{AggregatorOptions, Experience, Representation};
+use palc_aggregator::{AggregatorOptions, Experience, OwnLaneChange, Representation};
 use palc_planner::Weights;
 
 use crate::HarnessError;
 use crate::carry::{self, Carried, Names};
-use crate::onset::{UserLaneChange, onset_at};
+use crate::onset::{OwnShape, UserLaneChange, onset_at};
 use crate::scene_lessons::SceneLessons;
 use crate::setup::Setup;
 
@@ -38,6 +38,8 @@ pub struct LessonPaths<'a> {
     pub dt: f64,
     /// The target lane's centre (m).
     pub target_l: f64,
+    /// The user's own lane change as last seen whole, from the experience.
+    own: Option<OwnShape>,
     /// The user's lane change fitted to what it drove after the takeover.
     fitted: OnceCell<Option<UserLaneChange>>,
 }
@@ -57,16 +59,44 @@ impl<'a> LessonPaths<'a> {
             takeover_step,
             dt,
             target_l,
+            own: None,
             fitted: OnceCell::new(),
         }
+    }
+
+    /// These paths, with the user's own lane change as an experience last saw it
+    /// whole (`Experience::own_lane_change`): fitted beside the lane-change
+    /// models when the lesson shows only the end of the user's lane change.
+    #[must_use]
+    pub fn with_own_lane_change(mut self, own: Option<&OwnLaneChange>) -> Self {
+        self.own = own.and_then(OwnShape::stored);
+        self.fitted = OnceCell::new();
+        self
     }
 
     /// The user's own lane change fitted to what it drove after the takeover
     /// (`onset::UserLaneChange::fit_lesson`); `None` when too little is left to fit.
     fn fitted(&self) -> Option<UserLaneChange> {
-        *self.fitted.get_or_init(|| {
-            UserLaneChange::fit_lesson(self.driven_l, self.takeover_step, self.dt, self.target_l)
-        })
+        self.fitted
+            .get_or_init(|| {
+                UserLaneChange::fit_lesson(
+                    self.driven_l,
+                    self.takeover_step,
+                    self.dt,
+                    self.target_l,
+                    self.own.as_ref(),
+                )
+            })
+            .clone()
+    }
+
+    /// The user's whole lane change, when this lesson showed it from rest in its
+    /// lane to its end (the takeover came before the user's own start): its shape,
+    /// for the experience to keep. `None` otherwise.
+    pub fn own_lane_change_seen(&self) -> Option<OwnLaneChange> {
+        let user = self.fitted()?;
+        let own = user.own_shape_seen(self.driven_l, self.takeover_step, self.dt)?;
+        Some(own.to_stored())
     }
 }
 
@@ -112,6 +142,10 @@ pub trait Personalization: fmt::Debug + Send {
     fn observe_start(&self, experience: &mut Experience, setup: &Setup, start_s: f64) {
         record_onset(experience, setup, start_s);
     }
+
+    /// Records in the experience what `lesson` showed of the user's lane change
+    /// as a whole; by default nothing (the paper's method keeps no shape).
+    fn observe_lane_change(&self, _experience: &mut Experience, _lesson: &LessonPaths<'_>) {}
 }
 
 /// The implementations a method's options compose: [`Replay`] or
@@ -168,6 +202,15 @@ impl Personalization for RelativeOnset {
         previous: Option<&Experience>,
     ) -> Result<Carried, HarnessError> {
         carry::starting_experience(names, standard_weights, setup, previous, true)
+    }
+
+    /// Keeps the user's own lane change when the lesson showed it whole: later
+    /// lessons that see only its end place its start by it
+    /// (docs/experiments/0077-the-users-own-shape.md).
+    fn observe_lane_change(&self, experience: &mut Experience, lesson: &LessonPaths<'_>) {
+        if let Some(own) = lesson.own_lane_change_seen() {
+            experience.own_lane_change = Some(own);
+        }
     }
 }
 
@@ -227,6 +270,10 @@ impl<P: Personalization> Personalization for SceneAveraged<P> {
 
     fn observe_start(&self, experience: &mut Experience, setup: &Setup, start_s: f64) {
         self.inner.observe_start(experience, setup, start_s);
+    }
+
+    fn observe_lane_change(&self, experience: &mut Experience, lesson: &LessonPaths<'_>) {
+        self.inner.observe_lane_change(experience, lesson);
     }
 }
 
@@ -303,6 +350,36 @@ mod tests {
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max);
         assert!(worst < 0.1, "{worst}");
+    }
+
+    #[test]
+    fn palcs_personalization_keeps_the_users_own_lane_change_when_a_lesson_shows_it_whole() {
+        let weights = Weights::from_columns(vec![[1.0; palc_planner::FEATURE_COUNT]; 81]);
+        let fresh = Experience::new("user", "scene", "palc", weights, DT).unwrap();
+        let user = lane_change(5.0, 2.0, 80);
+        let planned = lane_change(3.0, 3.0, 80);
+        // Taken over at 4 s, before the user's start at 5 s: it kept its lane,
+        // then drove its whole lane change.
+        let takeover = 40;
+        let driven: Vec<f64> = (0..=80)
+            .map(|i| if i < takeover { planned[i] } else { user[i] })
+            .collect();
+        let whole = paths(&driven, &planned, takeover);
+        let own = whole.own_lane_change_seen().expect("seen from rest");
+        assert!(own.validate().is_ok());
+        let mut palc = fresh.clone();
+        SceneAveraged::new(RelativeOnset).observe_lane_change(&mut palc, &whole);
+        assert_eq!(palc.own_lane_change, Some(own));
+        // The paper's method keeps no shape.
+        let mut paper = fresh.clone();
+        Replay.observe_lane_change(&mut paper, &whole);
+        assert_eq!(paper, fresh);
+        // Taken over after the user's start, nothing is seen whole.
+        let late = paths(&user, &planned, 55);
+        assert_eq!(late.own_lane_change_seen(), None);
+        let mut kept = palc.clone();
+        RelativeOnset.observe_lane_change(&mut kept, &late);
+        assert_eq!(kept, palc);
     }
 
     #[test]

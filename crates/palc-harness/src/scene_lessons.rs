@@ -143,6 +143,7 @@ mod tests {
             duration_s,
             target_l: 3.5,
             shape: crate::onset::Shape::QUINTIC,
+            own: None,
         };
         let path = (0..120).map(|i| user.lateral(i as f64 * DT)).collect();
         (user, path)
@@ -172,7 +173,7 @@ mod tests {
         // right.
         let mut lessons = SceneLessons::default();
         let (late, late_path) = lane_change(13.0, 2.0);
-        lessons.add(late, late_path.clone(), DT);
+        lessons.add(late.clone(), late_path.clone(), DT);
         for start in [12.9, 13.0, 13.1] {
             lessons.accept(start);
         }
@@ -211,7 +212,7 @@ mod tests {
         let (user, path) = lane_change(4.03, 2.1);
         let mut lessons = SceneLessons::default();
         for _ in 0..3 {
-            let mean = lessons.add(user, path.clone(), DT).path.unwrap();
+            let mean = lessons.add(user.clone(), path.clone(), DT).path.unwrap();
             for (a, b) in mean.iter().zip(&path) {
                 assert!((a - b).abs() < 1e-12, "{a} != {b}");
             }

@@ -562,7 +562,8 @@ impl LearningLoop {
             takeover_step,
             setup.dt,
             setup.target_l,
-        );
+        )
+        .with_own_lane_change(learner.experience.own_lane_change.as_ref());
         let demonstration = learner.personalization.demonstrate(&paths);
         if let Some(path) = &demonstration.path {
             let mut states = lesson.executed.clone();
@@ -591,6 +592,7 @@ impl LearningLoop {
                         .personalization
                         .observe_start(experience, setup, start_s);
                 }
+                (learner.personalization).observe_lane_change(&mut outcome.experience, &paths);
                 observer.lesson(&LessonEvent::Learned {
                     lane_change,
                     lesson: &lesson,

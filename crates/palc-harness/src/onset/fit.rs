@@ -6,6 +6,16 @@
 //! model, whose onset a real driver's need not share
 //! (docs/experiments/0075-what-palc-believes-and-recorded-drivers.md).
 
+use super::own_shape::OwnShape;
+
+/// The root mean square distance (m) within which a lane-change model explains
+/// what the user drove: the fit through two crossings interpolated between 0.1 s
+/// steps leaves 1-5 mm on lane changes of the models' own shapes, and a recorded
+/// driver's onset, in no model, is missed by 2-10 cm. Within it the model is
+/// kept and the user's own shape ([`OwnShape`], sampled from another lesson) is
+/// not tried.
+const MODEL_EXPLAINS_RMS_M: f64 = 0.01;
+
 /// The lower fraction of the lane change whose crossing anchors the fit: low
 /// enough to lie early in the move, high enough to lie clear of the takeover's
 /// 0.3 m (8.6 % of a 3.5 m lane) in the usual first lesson.
@@ -154,9 +164,9 @@ fn crossing_s(profile: &[f64], from: usize, level: f64, dt: f64) -> Option<f64> 
 }
 
 /// The user's own lane change seen in a lesson: the lane-change model ([`Shape`])
-/// fitted to the lateral positions `driven_l` the user drove from
-/// `takeover_step` on, towards `target_l` from 0.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// or the user's own shape ([`OwnShape`]) fitted to the lateral positions
+/// `driven_l` the user drove from `takeover_step` on, towards `target_l` from 0.
+#[derive(Debug, Clone, PartialEq)]
 pub(crate) struct UserLaneChange {
     /// The user's start (s after the start of the plan).
     pub start_s: f64,
@@ -166,6 +176,9 @@ pub(crate) struct UserLaneChange {
     pub target_l: f64,
     /// The model that fitted best.
     pub shape: Shape,
+    /// The user's own shape, when it fitted better than every model; the lane
+    /// change then follows it, not `shape`.
+    pub own: Option<OwnShape>,
 }
 
 impl UserLaneChange {
@@ -183,6 +196,19 @@ impl UserLaneChange {
         dt: f64,
         target_l: f64,
     ) -> Option<UserLaneChange> {
+        UserLaneChange::fit_with(driven_l, takeover_step, dt, target_l, None)
+    }
+
+    /// [`UserLaneChange::fit`], with the user's own shape `own` fitted beside the
+    /// models through the same crossings: it is kept when its squared error is
+    /// smaller than the best model's.
+    pub(crate) fn fit_with(
+        driven_l: &[f64],
+        takeover_step: usize,
+        dt: f64,
+        target_l: f64,
+        own: Option<&OwnShape>,
+    ) -> Option<UserLaneChange> {
         if target_l == 0.0 || takeover_step >= driven_l.len() {
             return None;
         }
@@ -195,14 +221,18 @@ impl UserLaneChange {
         }
         let t_a = crossing_s(&profile, takeover_step, lower, dt)?;
         let t_b = crossing_s(&profile, takeover_step, upper, dt)?;
-        let fit = |shape: Shape| {
-            let (x_a, x_b) = (shape.inverse(lower), shape.inverse(upper));
+        let fit_form = |shape: Shape, own: Option<OwnShape>| {
+            let (x_a, x_b) = match &own {
+                Some(own) => (own.inverse(lower), own.inverse(upper)),
+                None => (shape.inverse(lower), shape.inverse(upper)),
+            };
             let duration = (t_b - t_a) / (x_b - x_a);
             let user = UserLaneChange {
                 start_s: (t_a - x_a * duration).max(0.0),
                 duration_s: duration,
                 target_l,
                 shape,
+                own,
             };
             let error: f64 = (profile.iter().enumerate().skip(takeover_step))
                 .take_while(|&(i, _)| i as f64 * dt <= t_b)
@@ -210,6 +240,14 @@ impl UserLaneChange {
                 .sum();
             (user, error)
         };
+        let fit = |shape: Shape| fit_form(shape, None);
+        // The samples each squared error sums over, for its root mean square.
+        let samples = (takeover_step..profile.len())
+            .take_while(|&i| i as f64 * dt <= t_b)
+            .count()
+            .max(1);
+        let model_explains =
+            |error: f64| (error / samples as f64).sqrt() * target_l.abs() <= MODEL_EXPLAINS_RMS_M;
         // The smaller squared error; the earlier model wins a tie.
         let better = |best: (UserLaneChange, f64), next: (UserLaneChange, f64)| {
             if next.1 < best.1 { next } else { best }
@@ -241,10 +279,17 @@ impl UserLaneChange {
             );
             best_of(base, &mut std::iter::once(peak).chain(around))
         };
-        let (best, _) = (Base::ALL.into_iter())
+        let best = (Base::ALL.into_iter())
             .filter_map(best_of_base)
             .reduce(better)?;
-        Some(best)
+        // The models first: they win a tie.
+        let best = match own {
+            Some(own) if !model_explains(best.1) => {
+                better(best.clone(), fit_form(best.0.shape, Some(own.clone())))
+            }
+            _ => best,
+        };
+        Some(best.0)
     }
 
     /// [`UserLaneChange::fit`] to a lesson, where the user drove `driven_l`
@@ -256,12 +301,27 @@ impl UserLaneChange {
         takeover_step: usize,
         dt: f64,
         target_l: f64,
+        own: Option<&OwnShape>,
     ) -> Option<UserLaneChange> {
-        let fitted = UserLaneChange::fit(driven_l, takeover_step, dt, target_l)?;
+        let fitted = UserLaneChange::fit_with(driven_l, takeover_step, dt, target_l, own)?;
         Some(match rest_bounds_s(driven_l, takeover_step, dt) {
             Some(bounds) => fitted.started_within(bounds),
             None => fitted,
         })
+    }
+
+    /// The user's whole lane change as its own shape, when the lesson it was
+    /// fitted to (`driven_l`, taken over at `takeover_step`) showed it from rest
+    /// in its lane ([`REST_M`]) to this fit's end; `None` otherwise.
+    pub(crate) fn own_shape_seen(
+        &self,
+        driven_l: &[f64],
+        takeover_step: usize,
+        dt: f64,
+    ) -> Option<OwnShape> {
+        rest_bounds_s(driven_l, takeover_step, dt)?;
+        let end_s = self.start_s + self.duration_s;
+        OwnShape::seen(driven_l, dt, self.target_l, self.start_s, end_s)
     }
 
     /// This lane change with its start moved into `(earliest, latest)` (s), its
@@ -282,7 +342,11 @@ impl UserLaneChange {
     /// The fitted lateral position (m) at time `t` (s): 0 before the start.
     pub(crate) fn lateral(&self, t: f64) -> f64 {
         let x = ((t - self.start_s) / self.duration_s).clamp(0.0, 1.0);
-        self.target_l * self.shape.fraction(x)
+        let done = match &self.own {
+            Some(own) => own.fraction(x),
+            None => self.shape.fraction(x),
+        };
+        self.target_l * done
     }
 
     /// The user's lateral path in the lesson it was fitted to: what the user drove
@@ -510,7 +574,7 @@ mod tests {
         // until step 50 and had moved at step 51.
         let fitted = UserLaneChange::fit(&driven, 40, dt, 3.5).unwrap();
         assert!((fitted.start_s - start).abs() > dt, "{fitted:?}");
-        let seen = UserLaneChange::fit_lesson(&driven, 40, dt, 3.5).unwrap();
+        let seen = UserLaneChange::fit_lesson(&driven, 40, dt, 3.5, None).unwrap();
         assert!((seen.start_s - start).abs() <= dt, "{seen:?}");
         // The end of the lane change is the model's.
         let end = |u: &UserLaneChange| u.start_s + u.duration_s;
@@ -518,11 +582,47 @@ mod tests {
     }
 
     #[test]
+    fn a_start_seen_only_after_it_is_placed_by_the_users_own_shape() {
+        let dt = 0.1;
+        // A first lesson shows the whole lane change from rest (takeover at 4 s,
+        // start at 5.03 s): its shape is the user's own.
+        let first = abrupt_profile(5.03, 3.0, dt, 120);
+        let seen = UserLaneChange::fit_lesson(&first, 40, dt, 3.5, None).unwrap();
+        let own = seen.own_shape_seen(&first, 40, dt).unwrap();
+        // A later lesson in another scene: the user started at 2.37 s and was
+        // taken over 0.4 s later, already moving.
+        let (start, later) = (2.37, abrupt_profile(2.37, 3.0, dt, 120));
+        assert_eq!(seen.own_shape_seen(&later, 27, dt), None, "no rest is seen");
+        let by_models = UserLaneChange::fit_lesson(&later, 27, dt, 3.5, None).unwrap();
+        let by_own = UserLaneChange::fit_lesson(&later, 27, dt, 3.5, Some(&own)).unwrap();
+        assert!((by_models.start_s - start).abs() > dt, "{by_models:?}");
+        assert!((by_own.start_s - start).abs() <= dt, "{by_own:?}");
+        assert!(by_own.own.is_some());
+        // Its path before the takeover follows the user's shape.
+        for (i, (got, want)) in (by_own.path(&later, 27, dt).iter().zip(&later)).enumerate() {
+            assert!((got - want).abs() < 0.05, "step {i}: {got} vs {want}");
+        }
+    }
+
+    #[test]
+    fn a_models_lane_change_keeps_its_model_beside_an_own_shape() {
+        // A quintic user: the model fits exactly and wins over the sampled shape.
+        let dt = 0.1;
+        let first = quintic_profile(5.03, 3.0, dt, 120);
+        let seen = UserLaneChange::fit_lesson(&first, 40, dt, 3.5, None).unwrap();
+        let own = seen.own_shape_seen(&first, 40, dt).unwrap();
+        let later = quintic_profile(2.37, 3.0, dt, 120);
+        let with = UserLaneChange::fit_lesson(&later, 27, dt, 3.5, Some(&own)).unwrap();
+        let without = UserLaneChange::fit_lesson(&later, 27, dt, 3.5, None).unwrap();
+        assert_eq!(with, without);
+    }
+
+    #[test]
     fn a_start_the_model_places_within_what_was_seen_is_kept() {
         let driven = quintic_profile(5.03, 3.0, 0.1, 120);
         for takeover in [30, 45, 50] {
             let fitted = UserLaneChange::fit(&driven, takeover, 0.1, 3.5).unwrap();
-            let seen = UserLaneChange::fit_lesson(&driven, takeover, 0.1, 3.5).unwrap();
+            let seen = UserLaneChange::fit_lesson(&driven, takeover, 0.1, 3.5, None).unwrap();
             assert_eq!(seen, fitted, "takeover at step {takeover}");
         }
     }

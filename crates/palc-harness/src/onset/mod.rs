@@ -12,7 +12,9 @@
 //! `D = (t_b − t_a) / (x(p_b) − x(p_a))` and the start `t_a − x(p_a) · D`. The
 //! crossings are interpolated between steps, so the start is found to a fraction
 //! of a step; a profile outside the models (a table, a seventh-order polynomial)
-//! biases it by a few percent of its duration.
+//! biases it by a few percent of its duration. Once a lesson has shown the user's
+//! whole lane change from rest, its own shape ([`OwnShape`]) is fitted beside the
+//! models in later lessons.
 //!
 //! The relative state at that start ([`Onset`]: time headway, time to collision
 //! and gap to the vehicle ahead, and a target-lane gap when it held the user back)
@@ -39,9 +41,11 @@
 //! requirement is assumed (the system's own, not fitted to any user).
 
 mod fit;
+mod own_shape;
 mod prediction;
 
 #[cfg(test)]
 pub(crate) use fit::Shape;
 pub(crate) use fit::UserLaneChange;
+pub(crate) use own_shape::OwnShape;
 pub(crate) use prediction::{onset_at, predicted_start_s};
