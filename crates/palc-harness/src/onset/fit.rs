@@ -10,10 +10,10 @@ use super::own_shape::OwnShape;
 
 /// The root mean square distance (m) within which a lane-change model explains
 /// what the user drove: the fit through two crossings interpolated between 0.1 s
-/// steps leaves 1-5 mm on lane changes of the models' own shapes, and a recorded
-/// driver's onset, in no model, is missed by 2-10 cm. Within it the model is
-/// kept and the user's own shape ([`OwnShape`], sampled from another lesson) is
-/// not tried.
+/// steps leaves 1-5 mm on lane changes of the models' own shapes; lessons the
+/// models miss lie at 1-23 cm (median 3.5 cm in the quick reproduction). Within it
+/// the model is kept and the user's own shape ([`OwnShape`], sampled from another
+/// lesson) is not tried (docs/experiments/0077-the-users-own-shape.md).
 const MODEL_EXPLAINS_RMS_M: f64 = 0.01;
 
 /// The lower fraction of the lane change whose crossing anchors the fit: low
