@@ -6,13 +6,17 @@
 //! it is ready and a worker is free, so no worker waits for a whole phase or
 //! wave to end while runs could start.
 //!
-//! Among the ready runs, the one heading the longest chain of computed runs that
-//! wait on it starts first, ties in plan order: critical-path list scheduling
-//! (Hu 1961; Graham 1969 bounds any such list schedule within twice the optimum).
-//! A drive is a chain of a hundred lane changes, each learning from the one
-//! before; started first, it runs beside the many short runs instead of after
-//! them. The order changes no result: a run's row depends only on its spec and
-//! the experience it starts from.
+//! Among the ready runs, the one on the longest chain of computed runs (through
+//! it, from the first run of the chain to the last) starts first, ties in plan
+//! order: critical-path list scheduling (Hu 1961; Graham 1969 bounds any such
+//! list schedule within twice the optimum). A drive is a chain of a hundred lane
+//! changes, each learning from the one before; started first, it runs beside the
+//! many short runs instead of after them. Every run of a chain has the chain's
+//! length, so a chain once started goes on before the next chain of the same
+//! length starts (plan order): a thread follows one drive, whose driver estimate
+//! extends the one before (the harness keeps the last posteriors), instead of
+//! advancing every drive by one lane change in turn. The order changes no result:
+//! a run's row depends only on its spec and the experience it starts from.
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
@@ -26,7 +30,7 @@ pub struct Schedule {
     waiting_on: Vec<usize>,
     /// For each run, the runs that need it.
     needed_by: Vec<Vec<usize>>,
-    /// For each run, the computed runs on the longest chain that starts with it.
+    /// For each run, the computed runs on the longest chain through it.
     chain: Vec<usize>,
     /// Ready runs: the longest chain first, then the lowest index.
     ready: BinaryHeap<(usize, Reverse<usize>)>,
@@ -53,14 +57,22 @@ impl Schedule {
                 needed_by[need].push(id);
             }
         }
-        // Runs need only earlier runs, so the chains are known from the back.
-        // A repeat costs no computation.
-        let mut chain = vec![0; n];
+        // Runs need only earlier runs, so the chains below a run are known from
+        // the back and the chains above it from the front. A repeat costs no
+        // computation.
+        let own = |id: usize| usize::from(original.get(id).is_none_or(|&of| of == id));
+        let mut below = vec![0; n];
         for id in (0..n).rev() {
-            let own = usize::from(original.get(id).is_none_or(|&of| of == id));
-            let below = needed_by[id].iter().map(|&d| chain[d]).max().unwrap_or(0);
-            chain[id] = own + below;
+            let next = needed_by[id].iter().map(|&d| below[d]).max().unwrap_or(0);
+            below[id] = own(id) + next;
         }
+        let mut above = vec![0; n];
+        for id in 0..n {
+            for &next in &needed_by[id] {
+                above[next] = above[next].max(above[id] + own(id));
+            }
+        }
+        let chain: Vec<usize> = (0..n).map(|id| above[id] + below[id]).collect();
         let ready = (0..n)
             .filter(|&id| waiting_on[id] == 0)
             .map(|id| (chain[id], Reverse(id)))
@@ -88,7 +100,7 @@ impl Schedule {
         }
     }
 
-    /// The computed runs on the longest chain that starts with run `id`.
+    /// The computed runs on the longest chain through run `id`.
     pub fn chain(&self, id: usize) -> usize {
         self.chain[id]
     }
@@ -145,6 +157,44 @@ mod tests {
             .find(|s| s.experiment == Experiment::Timing)
             .unwrap();
         assert_eq!(schedule.chain(alone.id), 1);
+        // Every run of a chain of single links has the chain's length.
+        for spec in plan.all() {
+            if let Some(source) = spec.experience_from {
+                if schedule.needed_by[source].len() == 1 && schedule.waiting_on[spec.id] == 1 {
+                    assert_eq!(schedule.chain(source), schedule.chain(spec.id));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_chain_once_started_goes_on_before_another_of_its_length_starts() {
+        // Accumulation over every speed case: chains of several scenes.
+        let mut selection = selection();
+        selection.grid.speed_cases = testbed().speed_cases.to_vec();
+        selection.transfer.accumulation_users = vec!["deterministic".into()];
+        let plan = expand(&selection, &testbed()).unwrap();
+        let original: Vec<usize> = (0..plan.len()).collect();
+        let schedule = Schedule::new(&plan, &original);
+        let order = order(&plan, &original);
+        let runs: Vec<_> = plan.all().collect();
+        let longest = schedule.chain(order[0]);
+        assert!(longest > 2, "the test plan has chains of runs");
+        // On one thread, the runs of the longest chains come one chain at a
+        // time: a run that learns from a run with experience (the second scene
+        // of a chain on) follows it at once.
+        let on_longest: Vec<usize> = (order.iter().copied())
+            .take_while(|&id| schedule.chain(id) == longest)
+            .collect();
+        let mut followed = 0;
+        for pair in on_longest.windows(2) {
+            let source = runs[pair[1]].experience_from;
+            if source.is_some_and(|s| runs[s].experience_from.is_some()) {
+                assert_eq!(source, Some(pair[0]), "{pair:?}");
+                followed += 1;
+            }
+        }
+        assert!(followed > 0, "the test plan has chains of three runs");
     }
 
     #[test]
@@ -156,11 +206,8 @@ mod tests {
         let schedule = Schedule::new(&plan, &original);
         assert_eq!(schedule.waiting_on[b], 1);
         assert!(schedule.needed_by[a].contains(&b));
-        let below = schedule.needed_by[b]
-            .iter()
-            .map(|&d| schedule.chain(d))
-            .max();
-        assert_eq!(schedule.chain(b), below.unwrap_or(0));
+        // A repeat adds nothing: its chain is no longer than its original's.
+        assert!(schedule.chain(b) <= schedule.chain(a));
         let order = order(&plan, &original);
         let at = |id| order.iter().position(|&x| x == id).unwrap();
         assert!(at(a) < at(b));

@@ -1,10 +1,12 @@
 //! The posterior over start models and the start it predicts in a new scene.
 
 use std::ops::Range;
+use std::sync::Arc;
 
 use palc_aggregator::Onset;
 use palc_user::{Situation, StartModel};
 
+use super::memo::{self, Accumulated};
 use super::prior::{self, Cue, LAG_GAPS_S, LEAD_GAPS_S, MISFIT_SDS, OBSERVATION_SD_S, REACTIONS_S};
 use super::scene::situations;
 
@@ -234,6 +236,35 @@ impl Misfit {
     }
 }
 
+impl Accumulated {
+    /// Adds the scene of `onset` (which has one) to the posterior: each
+    /// hypothesis's start there, run forward, against the observed start.
+    fn read(&mut self, grid: &Grid, onset: &Onset, duration_s: f64) {
+        let Some(scene) = &onset.scene else { return };
+        let seen = situations(scene);
+        let safe: Option<Vec<bool>> = scene.steps.iter().map(|s| s.safe).collect();
+        let view = SceneView::new(
+            &seen,
+            scene.dt,
+            scene.set_speed_mps,
+            safe.as_deref(),
+            duration_s,
+        );
+        let misfit = Misfit::new(seen.len(), scene.dt, onset.time_s);
+        let (worst, log_posterior) = (&mut self.worst, &mut self.log_posterior);
+        grid.for_each_start(&view, |hypotheses, start| {
+            let (error, penalty) = misfit.of(start);
+            for far in &mut worst[hypotheses.clone()] {
+                *far = far.max(error);
+            }
+            for lp in &mut log_posterior[hypotheses] {
+                *lp -= penalty;
+            }
+        });
+        self.scenes += 1;
+    }
+}
+
 /// What the estimate predicts in a scene.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Prediction {
@@ -263,42 +294,36 @@ impl DriverEstimate {
     /// did. Under the safety layer a start must keep the safe distance for a
     /// lane change of `duration_s`.
     pub fn from_onsets(onsets: &[Onset], duration_s: f64) -> Option<DriverEstimate> {
-        let grid = Grid::new();
-        let mut log_posterior = prior(&grid);
-        let mut worst = vec![0.0f64; grid.len()];
-        let mut scenes = 0;
-        for onset in onsets {
-            let Some(scene) = &onset.scene else { continue };
-            let seen = situations(scene);
-            let safe: Option<Vec<bool>> = scene.steps.iter().map(|s| s.safe).collect();
-            let view = SceneView::new(
-                &seen,
-                scene.dt,
-                scene.set_speed_mps,
-                safe.as_deref(),
-                duration_s,
-            );
-            let misfit = Misfit::new(seen.len(), scene.dt, onset.time_s);
-            grid.for_each_start(&view, |hypotheses, start| {
-                let (error, penalty) = misfit.of(start);
-                for far in &mut worst[hypotheses.clone()] {
-                    *far = far.max(error);
-                }
-                for lp in &mut log_posterior[hypotheses] {
-                    *lp -= penalty;
-                }
-            });
-            scenes += 1;
-        }
-        if scenes == 0 {
+        let seen: Vec<&Onset> = onsets.iter().filter(|o| o.scene.is_some()).collect();
+        if seen.is_empty() {
             return None;
         }
-        let closest_s = worst.iter().copied().fold(f64::INFINITY, f64::min);
+        let grid = Grid::new();
+        // A posterior of the first scenes, kept from an earlier estimate, is
+        // extended with the rest: the same sum, in the same order.
+        let (mut accumulated, read) = match memo::longest_beginning(&seen, duration_s) {
+            Some((kept, read)) => (Accumulated::clone(&kept), read),
+            None => (
+                Accumulated {
+                    log_posterior: prior(&grid),
+                    worst: vec![0.0f64; grid.len()],
+                    scenes: 0,
+                },
+                0,
+            ),
+        };
+        for onset in &seen[read..] {
+            accumulated.read(&grid, onset, duration_s);
+        }
+        if read < seen.len() {
+            memo::keep(&seen, duration_s, Arc::new(accumulated.clone()));
+        }
+        let closest_s = (accumulated.worst.iter().copied()).fold(f64::INFINITY, f64::min);
         Some(DriverEstimate {
             grid,
-            log_posterior,
+            log_posterior: accumulated.log_posterior,
             closest_s,
-            scenes,
+            scenes: accumulated.scenes,
         })
     }
 
@@ -579,6 +604,38 @@ mod tests {
                     "{:?}: log likelihood {}", model, log_likelihood
                 );
             }
+        }
+    }
+
+    #[test]
+    fn an_estimate_extended_from_a_kept_one_is_the_one_computed_afresh() {
+        let grid = Grid::new();
+        let model = grid.model(12_345);
+        let onsets: Vec<Onset> = (scenes().iter())
+            .filter_map(|setup| observed(&model, setup))
+            .collect();
+        assert!(onsets.len() >= 3, "the test needs three scenes");
+        let afresh = |onsets: &[Onset]| {
+            let mut accumulated = Accumulated {
+                log_posterior: prior(&grid),
+                worst: vec![0.0; grid.len()],
+                scenes: 0,
+            };
+            for onset in onsets {
+                accumulated.read(&grid, onset, 2.0);
+            }
+            accumulated
+        };
+        // The first two scenes are kept, the third extends them.
+        let kept = DriverEstimate::from_onsets(&onsets[..2], 2.0).unwrap();
+        let extended = DriverEstimate::from_onsets(&onsets, 2.0).unwrap();
+        for (estimate, onsets) in [(kept, &onsets[..2]), (extended, &onsets[..])] {
+            let fresh = afresh(onsets);
+            assert_eq!(estimate.scenes, fresh.scenes);
+            let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+            assert!(bits(&estimate.log_posterior) == bits(&fresh.log_posterior));
+            let closest = fresh.worst.iter().copied().fold(f64::INFINITY, f64::min);
+            assert_eq!(estimate.closest_s.to_bits(), closest.to_bits());
         }
     }
 

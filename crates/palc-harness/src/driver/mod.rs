@@ -32,6 +32,7 @@
 //! docs/experiments/0073-a-drive-of-varied-scenes.md).
 
 mod estimate;
+mod memo;
 pub mod prior;
 mod scene;
 
