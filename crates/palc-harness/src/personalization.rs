@@ -98,6 +98,15 @@ impl<'a> LessonPaths<'a> {
         let own = user.own_shape_seen(self.driven_l, self.takeover_step, self.dt)?;
         Some(own.to_stored())
     }
+
+    /// The user's lane change as the model fitted to this lesson, when the lesson
+    /// pins the model down (`onset::UserLaneChange::own_shape_fitted`): the
+    /// shape for an experience that has not seen one whole. `None` otherwise.
+    pub fn own_lane_change_fitted(&self) -> Option<OwnLaneChange> {
+        let user = self.fitted()?;
+        let own = user.own_shape_fitted(self.driven_l, self.takeover_step, self.dt)?;
+        Some(own.to_stored())
+    }
 }
 
 /// What a lesson teaches.
@@ -204,12 +213,16 @@ impl Personalization for RelativeOnset {
         carry::starting_experience(names, standard_weights, setup, previous, true)
     }
 
-    /// Keeps the user's own lane change when the lesson showed it whole: later
+    /// Keeps the user's own lane change when the lesson showed it whole, or,
+    /// when the experience has none, the model that fitted a lesson exactly: later
     /// lessons that see only its end place its start by it
-    /// (docs/experiments/0077-the-users-own-shape.md).
+    /// (docs/experiments/0077-the-users-own-shape.md,
+    /// docs/experiments/0079-a-reaction-and-a-shape-pinned-down.md).
     fn observe_lane_change(&self, experience: &mut Experience, lesson: &LessonPaths<'_>) {
         if let Some(own) = lesson.own_lane_change_seen() {
             experience.own_lane_change = Some(own);
+        } else if experience.own_lane_change.is_none() {
+            experience.own_lane_change = lesson.own_lane_change_fitted();
         }
     }
 }
@@ -380,6 +393,19 @@ mod tests {
         let mut kept = palc.clone();
         RelativeOnset.observe_lane_change(&mut kept, &late);
         assert_eq!(kept, palc);
+        // Taken over just after the user's start, the quintic explains what it
+        // drove: the fitted model is kept by an experience without a shape, and
+        // never replaces one seen whole.
+        let early = (0..=80).find(|&i| user[i] > 0.1).unwrap();
+        let pinned = paths(&user, &planned, early);
+        assert_eq!(pinned.own_lane_change_seen(), None);
+        let fitted = pinned.own_lane_change_fitted().expect("pinned down");
+        let mut without = fresh.clone();
+        RelativeOnset.observe_lane_change(&mut without, &pinned);
+        assert_eq!(without.own_lane_change, Some(fitted));
+        let mut with_whole = palc.clone();
+        RelativeOnset.observe_lane_change(&mut with_whole, &pinned);
+        assert_eq!(with_whole, palc);
     }
 
     #[test]

@@ -81,22 +81,25 @@ impl Grid {
         }
     }
 
-    /// The start step of every hypothesis in a scene ([`NEVER`] for none): the
-    /// fast form of [`StartModel::start_step`] (a test checks the two agree),
-    /// sharing each threshold's decision step across the combinations and each
-    /// pair of gaps' next acceptable step across the reactions. A model that has
-    /// decided at the scene's first step never starts in it: its driver would
-    /// have changed lanes before the system planned (palc-user refuses such a
-    /// scene for a simulated user).
+    /// The start step of every hypothesis in a scene ([`NEVER`] for none), as
+    /// [`Grid::for_each_start`] visits them: the list a test checks against
+    /// [`StartModel::start_step`].
+    #[cfg(test)]
     fn starts(&self, scene: &SceneView<'_>) -> Vec<u32> {
         let mut starts = vec![NEVER; self.len()];
         self.for_each_start(scene, |hypotheses, start| starts[hypotheses].fill(start));
         starts
     }
 
-    /// Calls `visit(hypotheses, start)` with every hypothesis once, as [`Grid::starts`]
-    /// lists them, without the list: `hypotheses` are consecutive thresholds of one
-    /// combination that decide at the same step, and so start at the same step.
+    /// Calls `visit(hypotheses, start)` with every hypothesis once and its start
+    /// step in a scene ([`NEVER`] for none): the fast form of
+    /// [`StartModel::start_step`] (a test checks the two agree), sharing each
+    /// threshold's decision step across the combinations and each pair of gaps'
+    /// next acceptable step across the reactions. `hypotheses` are consecutive
+    /// thresholds of one combination that decide at the same step, and so start
+    /// at the same step. A model that has decided at the scene's first step never
+    /// starts in it: its driver would have changed lanes before the system
+    /// planned (palc-user refuses such a scene for a simulated user).
     fn for_each_start(&self, scene: &SceneView<'_>, mut visit: impl FnMut(Range<usize>, u32)) {
         let n = scene.situations.len();
         let mut decision = vec![NEVER; self.thresholds];
@@ -427,6 +430,27 @@ impl DriverEstimate {
             .collect()
     }
 
+    /// The posterior mass of the start models for which `holds(cue, reaction_s)`.
+    pub fn mass_where(&self, holds: impl Fn(Cue, f64) -> bool) -> f64 {
+        let top = self.top();
+        let nt = self.grid.thresholds;
+        let (mut total, mut mass) = (0.0, 0.0);
+        for c in 0..Grid::combinations() {
+            let (reaction_s, _, _) = combination(c);
+            for (cue, first, thresholds) in &self.grid.cues {
+                let start = c * nt + first;
+                let cue_mass: f64 = (self.log_posterior[start..start + thresholds.len()].iter())
+                    .map(|&lp| weight(lp, top))
+                    .sum();
+                total += cue_mass;
+                if holds(*cue, reaction_s) {
+                    mass += cue_mass;
+                }
+            }
+        }
+        if total > 0.0 { mass / total } else { 0.0 }
+    }
+
     /// The start predicted in a scene (`situations` at step `dt`, the ego's set
     /// speed, the safety layer's verdict per step when it is on, a lane change
     /// of `duration_s`): the start step with the largest posterior mass, the
@@ -443,10 +467,22 @@ impl DriverEstimate {
             return Prediction::OutsideModel;
         }
         let view = SceneView::new(situations, dt, set_speed_mps, safe, duration_s);
-        let starts = self.grid.starts(&view);
-        match starts[self.most_probable_index()] {
-            NEVER => Prediction::NoStart,
-            start => Prediction::Start(f64::from(start) * dt),
+        let top = self.top();
+        // The posterior mass of each start step, the last entry for "never".
+        let mut mass = vec![0.0; situations.len() + 1];
+        self.grid.for_each_start(&view, |hypotheses, start| {
+            let at = (start as usize).min(situations.len());
+            mass[at] += (self.log_posterior[hypotheses].iter())
+                .map(|&lp| weight(lp, top))
+                .sum::<f64>();
+        });
+        let (step, _) = (mass.iter().enumerate()).fold((0, f64::NEG_INFINITY), |best, (i, &m)| {
+            if m > best.1 { (i, m) } else { best }
+        });
+        if step == situations.len() {
+            Prediction::NoStart
+        } else {
+            Prediction::Start(step as f64 * dt)
         }
     }
 
@@ -754,6 +790,59 @@ mod tests {
         let belief = carried.belief.expect("two recorded scenes or more");
         assert_eq!(belief.scenes, seen.len());
         assert!(!belief.outside_model);
+    }
+
+    #[test]
+    fn a_driver_who_starts_a_reaction_after_deciding_is_the_estimates_to_predict() {
+        use super::super::start_beyond_readings;
+        let setups = more_scenes();
+        let reacting = StartModel {
+            rule: palc_user::StartRule::TimeHeadway,
+            time_headway_s: 1.2,
+            reaction_s: 0.8,
+            min_lead_gap_s: 0.0,
+            min_lag_gap_s: 0.0,
+        };
+        let onsets: Vec<(usize, Onset)> = (0..setups.len())
+            .filter_map(|i| observed(&reacting, &setups[i]).map(|o| (i, o)))
+            .collect();
+        let (last, seen) = onsets.split_last().expect("the driver starts somewhere");
+        let seen: Vec<Onset> = seen.iter().map(|(_, o)| o.clone()).collect();
+        assert!(seen.len() >= 3, "the test needs three scenes");
+        let estimate = DriverEstimate::from_onsets(&seen, 2.0).unwrap();
+        let reacts = estimate.mass_where(|_, reaction_s| reaction_s > 0.0);
+        assert!(
+            reacts >= super::super::CREDIBLE_MASS,
+            "{reacts}: {}",
+            estimate.describe()
+        );
+        let predicted = start_beyond_readings(&setups[last.0], &seen, 2.0).start_s;
+        let predicted = predicted.expect("the scenes single the reaction out");
+        assert!(
+            (predicted - last.1.time_s).abs() < setups[last.0].dt / 2.0,
+            "{predicted} against {}",
+            last.1.time_s
+        );
+    }
+
+    #[test]
+    fn the_mass_of_a_set_of_models_and_of_the_rest_make_the_whole() {
+        let setups = scenes();
+        let model = Grid::new().model(12_345);
+        let seen: Vec<Onset> = (setups.iter())
+            .filter_map(|s| observed(&model, s))
+            .collect();
+        let estimate = DriverEstimate::from_onsets(&seen, 2.0).unwrap();
+        for (name, mass) in estimate.cue_masses() {
+            let by_cue = estimate.mass_where(|cue, _| cue.name() == name);
+            assert!(
+                (by_cue - mass).abs() < 1e-12,
+                "{name}: {by_cue} against {mass}"
+            );
+        }
+        let slow = estimate.mass_where(|_, reaction_s| reaction_s >= 0.5);
+        let quick = estimate.mass_where(|_, reaction_s| reaction_s < 0.5);
+        assert!((slow + quick - 1.0).abs() < 1e-12, "{slow} + {quick}");
     }
 
     #[test]

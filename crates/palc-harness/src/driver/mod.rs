@@ -45,11 +45,14 @@ use serde::{Deserialize, Serialize};
 use crate::setup::Setup;
 use prior::Cue;
 
-/// The cues the onsets' readings read (`crate::onset::predicted_start_s`).
+/// The cues the onsets' readings read (`crate::onset::predicted_start_s`). The
+/// readings read the decision at the start itself: a driver who starts a
+/// reaction after deciding is a model they cannot represent either.
 const READ_BY_THE_READINGS: [Cue; 3] = [Cue::TimeHeadway, Cue::TimeToCollision, Cue::DistanceGap];
 
-/// The posterior mass a cue the readings do not read must hold before the
-/// estimate predicts: the usual 95 % credibility. One scene never gives it when
+/// The posterior mass the models the readings cannot represent (a cue they do
+/// not read, or a reaction) must hold before the estimate predicts: the usual
+/// 95 % credibility. One scene never gives it when
 /// another cue explains the same start with a longer reaction (a reaction user's
 /// start, read as an incentive decision, cost it takeovers at a majority of 50 %).
 const CREDIBLE_MASS: f64 = 0.95;
@@ -79,8 +82,8 @@ pub struct CarriedBelief {
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub(crate) struct CarriedEstimate {
     /// The start (s after the start of the plan) the estimate predicts, when it
-    /// places the decision on a cue the readings do not read, with
-    /// [`CREDIBLE_MASS`] of the posterior, from at least [`MIN_SCENES`] scenes:
+    /// places [`CREDIBLE_MASS`] of the posterior on models the readings cannot
+    /// represent (a cue they do not read, or a reaction after the decision), from at least [`MIN_SCENES`] scenes:
     /// the readings cannot represent such a driver, the estimate can. `None`
     /// otherwise (the readings predict), and for a driver outside the model or a
     /// scene the estimate says it does not start in.
@@ -111,7 +114,9 @@ pub(crate) fn start_beyond_readings(
         cue_mass: mass,
         outside_model: estimate.outside_model(),
     });
-    if READ_BY_THE_READINGS.contains(&cue) || mass < CREDIBLE_MASS {
+    let beyond_the_readings = estimate
+        .mass_where(|cue, reaction_s| !READ_BY_THE_READINGS.contains(&cue) || reaction_s > 0.0);
+    if beyond_the_readings < CREDIBLE_MASS {
         return CarriedEstimate {
             start_s: None,
             belief,

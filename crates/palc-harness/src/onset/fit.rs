@@ -324,6 +324,38 @@ impl UserLaneChange {
         OwnShape::seen(driven_l, dt, self.target_l, self.start_s, end_s)
     }
 
+    /// The user's shape as this fit's model, when the lesson pins it down: the
+    /// takeover came early enough for the peak to be fitted
+    /// ([`SKEW_MAX_TAKEOVER_FRACTION`]) and the model explains what the user
+    /// drove from the takeover to the lane change's end within
+    /// [`MODEL_EXPLAINS_RMS_M`]. A later lesson that sees the lane change only
+    /// from further on fits the symmetric models alone; with this shape beside
+    /// them its start is placed as the early lesson placed it. `None` otherwise,
+    /// and for a fit that already follows the user's own shape.
+    pub(crate) fn own_shape_fitted(
+        &self,
+        driven_l: &[f64],
+        takeover_step: usize,
+        dt: f64,
+    ) -> Option<OwnShape> {
+        if self.own.is_some() || self.target_l == 0.0 {
+            return None;
+        }
+        let at_takeover = driven_l.get(takeover_step)? / self.target_l;
+        if at_takeover > SKEW_MAX_TAKEOVER_FRACTION {
+            return None;
+        }
+        let end_s = self.start_s + self.duration_s;
+        let (squared, samples) = (driven_l.iter().enumerate().skip(takeover_step))
+            .take_while(|&(i, _)| i as f64 * dt <= end_s)
+            .fold((0.0, 0usize), |(sum, n), (i, &l)| {
+                (sum + (l - self.lateral(i as f64 * dt)).powi(2), n + 1)
+            });
+        let rms = (squared / samples.max(1) as f64).sqrt();
+        (samples > 0 && rms <= MODEL_EXPLAINS_RMS_M)
+            .then(|| OwnShape::of_model(|x| self.shape.fraction(x)))
+    }
+
     /// This lane change with its start moved into `(earliest, latest)` (s), its
     /// end kept: what was seen of the user outranks the model's extrapolation.
     fn started_within(self, (earliest, latest): (f64, f64)) -> UserLaneChange {
@@ -602,6 +634,53 @@ mod tests {
         for (i, (got, want)) in (by_own.path(&later, 27, dt).iter().zip(&later)).enumerate() {
             assert!((got - want).abs() < 0.05, "step {i}: {got} vs {want}");
         }
+    }
+
+    #[test]
+    fn a_late_peak_pinned_down_early_places_a_start_seen_late() {
+        let (dt, duration) = (0.1, 2.0);
+        let late_peak = Shape {
+            base: Base::Quintic,
+            peak: 0.65,
+        };
+        let lane_change = |start: f64| -> Vec<f64> {
+            (0..120)
+                .map(|i| {
+                    3.5 * late_peak.fraction(((i as f64 * dt - start) / duration).clamp(0.0, 1.0))
+                })
+                .collect()
+        };
+        // Taken over at 5 % of the lane change: the peak is fitted and explains
+        // the path, so the lesson pins the shape down.
+        let first = lane_change(4.0);
+        let early = (0..first.len()).find(|&i| first[i] >= 0.05 * 3.5).unwrap();
+        let seen = UserLaneChange::fit_lesson(&first, early, dt, 3.5, None).unwrap();
+        assert!((seen.start_s - 4.0).abs() < 0.03, "{seen:?}");
+        let pinned = seen
+            .own_shape_fitted(&first, early, dt)
+            .expect("pinned down");
+        // Taken over at a third of it, only the symmetric models are fitted.
+        let (start, later) = (3.33, lane_change(3.33));
+        let late = (0..later.len()).find(|&i| later[i] >= 0.3 * 3.5).unwrap();
+        assert_eq!(
+            seen.own_shape_fitted(&later, late, dt),
+            None,
+            "seen too late"
+        );
+        let by_models = UserLaneChange::fit_lesson(&later, late, dt, 3.5, None).unwrap();
+        let by_pinned = UserLaneChange::fit_lesson(&later, late, dt, 3.5, Some(&pinned)).unwrap();
+        assert!((by_models.start_s - start).abs() > dt, "{by_models:?}");
+        assert!((by_pinned.start_s - start).abs() < 0.03, "{by_pinned:?}");
+    }
+
+    #[test]
+    fn a_path_the_model_misses_pins_no_shape_down() {
+        let dt = 0.1;
+        // The abrupt onset is in neither base: the best model misses it by more
+        // than the centimetre within which a model explains a path.
+        let driven = abrupt_profile(4.0, 3.0, dt, 120);
+        let fitted = UserLaneChange::fit_lesson(&driven, 41, dt, 3.5, None).unwrap();
+        assert_eq!(fitted.own_shape_fitted(&driven, 41, dt), None);
     }
 
     #[test]

@@ -13,6 +13,11 @@
 //! asymmetric onset is in no model; fitted with the models, its start came out
 //! 0.25-1.3 s early (docs/experiments/0075-what-palc-believes-and-recorded-drivers.md).
 //!
+//! Until a lesson shows it whole, a lesson that pins a model down stands for it
+//! ([`super::UserLaneChange::own_shape_fitted`]: taken over early enough for the
+//! peak to be fitted, and explained within a centimetre): a late-peak user's
+//! later lessons, seen only from a third of the way on, then keep their start.
+//!
 //! The shape assumes what the models assume: the user changes lanes with the
 //! same shape in every scene, stretched over its duration and the lane's width.
 
@@ -68,6 +73,24 @@ impl OwnShape {
         Some(OwnShape {
             progress: progress.into(),
         })
+    }
+
+    /// The shape of a lane-change model: `fraction(x)`, the fraction of the lane
+    /// change done at the fraction `x` of its duration, sampled and held as
+    /// [`OwnShape::seen`] holds a driven path.
+    pub(crate) fn of_model(fraction: impl Fn(f64) -> f64) -> OwnShape {
+        let mut highest = 0.0f64;
+        let mut progress: Vec<f64> = (0..SAMPLES)
+            .map(|k| {
+                highest = highest.max(fraction(k as f64 / (SAMPLES - 1) as f64).clamp(0.0, 1.0));
+                highest
+            })
+            .collect();
+        progress[0] = 0.0;
+        progress[SAMPLES - 1] = 1.0;
+        OwnShape {
+            progress: progress.into(),
+        }
     }
 
     /// The shape an experience keeps, `None` when it fails the checks of
