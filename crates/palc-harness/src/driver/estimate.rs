@@ -454,7 +454,7 @@ impl DriverEstimate {
     /// The start predicted in a scene (`situations` at step `dt`, the ego's set
     /// speed, the safety layer's verdict per step when it is on, a lane change
     /// of `duration_s`): the start step with the largest posterior mass, the
-    /// earliest of equals.
+    /// earliest of equals ([`DriverEstimate::start_masses`]).
     pub fn predict(
         &self,
         situations: &[Situation],
@@ -466,30 +466,53 @@ impl DriverEstimate {
         if self.outside_model() {
             return Prediction::OutsideModel;
         }
+        let masses = self.start_masses(situations, dt, set_speed_mps, safe, duration_s);
+        match most_likely_step(&masses) {
+            step if step == situations.len() => Prediction::NoStart,
+            step => Prediction::Start(step as f64 * dt),
+        }
+    }
+
+    /// The posterior predictive of the start step in a scene (as
+    /// [`DriverEstimate::predict`] takes it): the posterior mass of the models
+    /// that start at each step, the last entry for those that never start;
+    /// summing to 1.
+    pub fn start_masses(
+        &self,
+        situations: &[Situation],
+        dt: f64,
+        set_speed_mps: f64,
+        safe: Option<&[bool]>,
+        duration_s: f64,
+    ) -> Vec<f64> {
         let view = SceneView::new(situations, dt, set_speed_mps, safe, duration_s);
         let top = self.top();
-        // The posterior mass of each start step, the last entry for "never".
-        let mut mass = vec![0.0; situations.len() + 1];
+        let mut masses = vec![0.0; situations.len() + 1];
         self.grid.for_each_start(&view, |hypotheses, start| {
             let at = (start as usize).min(situations.len());
-            mass[at] += (self.log_posterior[hypotheses].iter())
+            masses[at] += (self.log_posterior[hypotheses].iter())
                 .map(|&lp| weight(lp, top))
                 .sum::<f64>();
         });
-        let (step, _) = (mass.iter().enumerate()).fold((0, f64::NEG_INFINITY), |best, (i, &m)| {
-            if m > best.1 { (i, m) } else { best }
-        });
-        if step == situations.len() {
-            Prediction::NoStart
-        } else {
-            Prediction::Start(step as f64 * dt)
+        let total: f64 = masses.iter().sum();
+        if total > 0.0 {
+            masses.iter_mut().for_each(|m| *m /= total);
         }
+        masses
     }
 
     /// The largest log posterior.
     fn top(&self) -> f64 {
         (self.log_posterior.iter().copied()).fold(f64::NEG_INFINITY, f64::max)
     }
+}
+
+/// The index of the largest of `masses`, the first of equals.
+pub(crate) fn most_likely_step(masses: &[f64]) -> usize {
+    let (step, _) = (masses.iter().enumerate()).fold((0, f64::NEG_INFINITY), |best, (i, &m)| {
+        if m > best.1 { (i, m) } else { best }
+    });
+    step
 }
 
 /// The posterior weight of a hypothesis of log posterior `lp`, scaled so that
@@ -778,14 +801,26 @@ mod tests {
             (predicted - expected).abs() < dt / 2.0,
             "{predicted} against {expected}"
         );
-        // A headway driver is the readings' to predict, however many scenes.
+        // A headway driver seen in the other scenes: the estimate is sure of its
+        // start in the last one within a step, and predicts it.
         let headway = driver(Cue::TimeHeadway, 1.2);
         let seen: Vec<Onset> = (setups.iter())
             .filter_map(|s| observed(&headway, s))
             .collect();
-        assert!(seen.len() >= 2);
+        assert!(seen.len() >= 3);
+        let (last, before) = seen.split_last().unwrap();
+        let target = (setups.iter())
+            .position(|s| s.label == last.scenario)
+            .unwrap();
+        let dt = setups[target].dt;
+        let carried = start_beyond_readings(&setups[target], before, 2.0);
+        let predicted = carried.start_s.expect("sure of the start within a step");
+        assert!(
+            (predicted - last.time_s).abs() < dt / 2.0,
+            "{predicted} against {}",
+            last.time_s
+        );
         let carried = start_beyond_readings(&setups[0], &seen, 2.0);
-        assert_eq!(carried.start_s, None);
         // What the estimate believed is kept: a headway driver inside the model.
         let belief = carried.belief.expect("two recorded scenes or more");
         assert_eq!(belief.scenes, seen.len());
@@ -843,6 +878,21 @@ mod tests {
         let slow = estimate.mass_where(|_, reaction_s| reaction_s >= 0.5);
         let quick = estimate.mass_where(|_, reaction_s| reaction_s < 0.5);
         assert!((slow + quick - 1.0).abs() < 1e-12, "{slow} + {quick}");
+        // The posterior predictive of the start in a scene sums to 1, and the
+        // prediction is its largest step.
+        let (scene, dt, speed) = (&setups[0].situations, setups[0].dt, setups[0].set_speed);
+        let masses = estimate.start_masses(scene, dt, speed, None, 2.0);
+        assert!((masses.iter().sum::<f64>() - 1.0).abs() < 1e-9);
+        let step = most_likely_step(&masses);
+        assert!(masses.iter().all(|&m| m <= masses[step]));
+        assert_eq!(
+            estimate.predict(scene, dt, speed, None, 2.0),
+            if step == scene.len() {
+                Prediction::NoStart
+            } else {
+                Prediction::Start(step as f64 * dt)
+            }
+        );
     }
 
     #[test]

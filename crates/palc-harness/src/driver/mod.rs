@@ -50,9 +50,11 @@ use prior::Cue;
 /// reaction after deciding is a model they cannot represent either.
 const READ_BY_THE_READINGS: [Cue; 3] = [Cue::TimeHeadway, Cue::TimeToCollision, Cue::DistanceGap];
 
-/// The posterior mass the models the readings cannot represent (a cue they do
-/// not read, or a reaction) must hold before the estimate predicts: the usual
-/// 95 % credibility. One scene never gives it when
+/// The usual 95 % credibility, asked of the estimate before it predicts a
+/// carried start in place of the readings: either of the posterior on models
+/// the readings cannot represent (a cue they do not read, or a reaction), or of
+/// the posterior predictive on the predicted start step and its two neighbours
+/// (the estimate is sure of the start within a step, whatever the model). One scene never gives it when
 /// another cue explains the same start with a longer reaction (a reaction user's
 /// start, read as an incentive decision, cost it takeovers at a majority of 50 %).
 const CREDIBLE_MASS: f64 = 0.95;
@@ -83,10 +85,11 @@ pub struct CarriedBelief {
 pub(crate) struct CarriedEstimate {
     /// The start (s after the start of the plan) the estimate predicts, when it
     /// places [`CREDIBLE_MASS`] of the posterior on models the readings cannot
-    /// represent (a cue they do not read, or a reaction after the decision), from at least [`MIN_SCENES`] scenes:
-    /// the readings cannot represent such a driver, the estimate can. `None`
-    /// otherwise (the readings predict), and for a driver outside the model or a
-    /// scene the estimate says it does not start in.
+    /// represent (a cue they do not read, or a reaction after the decision) or
+    /// of the posterior predictive within a step of the start it predicts, from
+    /// at least [`MIN_SCENES`] scenes. `None` otherwise (the readings predict),
+    /// and for a driver outside the model or a scene the estimate says it does
+    /// not start in.
     pub start_s: Option<f64>,
     /// What the estimate believed; `None` below [`MIN_SCENES`] recorded scenes,
     /// where it is not computed.
@@ -114,26 +117,30 @@ pub(crate) fn start_beyond_readings(
         cue_mass: mass,
         outside_model: estimate.outside_model(),
     });
-    let beyond_the_readings = estimate
-        .mass_where(|cue, reaction_s| !READ_BY_THE_READINGS.contains(&cue) || reaction_s > 0.0);
-    if beyond_the_readings < CREDIBLE_MASS {
+    if estimate.outside_model() {
         return CarriedEstimate {
             start_s: None,
             belief,
         };
     }
+    let beyond_the_readings = estimate
+        .mass_where(|cue, reaction_s| !READ_BY_THE_READINGS.contains(&cue) || reaction_s > 0.0);
     let steps = scene_steps(setup);
     let safe: Option<Vec<bool>> = steps.steps.iter().map(|s| s.safe).collect();
-    let predicted = estimate.predict(
+    let masses = estimate.start_masses(
         &setup.situations,
         setup.dt,
         setup.set_speed,
         safe.as_deref(),
         duration_s,
     );
-    let start_s = match predicted {
-        Prediction::Start(start_s) => Some(start_s),
-        Prediction::NoStart | Prediction::OutsideModel => None,
-    };
+    // The posterior predictive mass within a step of the predicted start: a
+    // start a step off moves the plan by less than the takeover threshold.
+    let step = estimate::most_likely_step(&masses);
+    let within_a_step: f64 = masses[step.saturating_sub(1)..(step + 2).min(masses.len() - 1)]
+        .iter()
+        .sum();
+    let predicts = beyond_the_readings >= CREDIBLE_MASS || within_a_step >= CREDIBLE_MASS;
+    let start_s = (predicts && step < setup.situations.len()).then_some(step as f64 * setup.dt);
     CarriedEstimate { start_s, belief }
 }
