@@ -10,7 +10,8 @@
 //! collision, distance gap, or MOBIL's incentive) with its threshold, the
 //! reaction, and the lead and lag gaps accepted. A model's likelihood in a scene
 //! compares the start it predicts there, run forward over every step, with the
-//! start observed (Gaussian, [`prior::OBSERVATION_SD_S`]): a model that would have
+//! start observed (Gaussian, [`prior::OBSERVATION_SD_S`], or misread anywhere
+//! in the scene with [`prior::MISREAD_START_PROBABILITY`]): a model that would have
 //! started earlier, or later, is penalized alike, so the steps at which the
 //! driver did not start count as much as its start. Scenes combine by
 //! multiplying likelihoods. When no model explains every scene to within
@@ -21,15 +22,16 @@
 //! when an observer asks (`palc learn` prints it after every lesson). A run
 //! keeps what the estimate believed when its experience was carried in
 //! ([`CarriedBelief`], in `RunResult::carried_belief`); the evaluation counts the
-//! misfits per user kind. The start carried into a new
-//! scene is predicted by the onsets' readings (`crate::onset`), which read the
-//! time headway, the time to collision and the distance gap; as the predictor
-//! for those cues the estimate's most probable model (and, separately, a refusal
-//! to carry a start for a driver outside the model) cost more takeovers on the
-//! evaluation's grid (docs/experiments/0068-one-driver-model.md). For a driver
-//! whose decision the estimate places on a cue the readings do not read (MOBIL's
-//! incentive), the estimate predicts (`start_beyond_readings`,
-//! docs/experiments/0073-a-drive-of-varied-scenes.md).
+//! misfits per user kind. The start carried into a new scene is predicted by
+//! the onsets' readings (`crate::onset`), which read the time headway, the time
+//! to collision and the distance gap at the start itself; as the predictor for
+//! those cues the estimate's most probable model cost more takeovers on the
+//! evaluation's grid (docs/experiments/0068-one-driver-model.md). The estimate
+//! predicts instead (`start_beyond_readings`): the start step with the largest
+//! posterior mass, when 95 % of the posterior lies on models the readings
+//! cannot represent (MOBIL's incentive, a reaction after the decision;
+//! docs/experiments/0073-a-drive-of-varied-scenes.md, 0079) or 95 % of the
+//! predictive within a step of that start (0080).
 
 mod estimate;
 mod memo;
@@ -142,5 +144,17 @@ pub(crate) fn start_beyond_readings(
         .sum();
     let predicts = beyond_the_readings >= CREDIBLE_MASS || within_a_step >= CREDIBLE_MASS;
     let start_s = (predicts && step < setup.situations.len()).then_some(step as f64 * setup.dt);
+    if std::env::var_os("PALC_DEBUG").is_some() && predicts {
+        let readings = crate::onset::predicted_start_s(setup, onsets, duration_s);
+        eprintln!(
+            "DBG {} | est {:?} sure {:.3} beyond {:.3} | readings {:?} | {}",
+            setup.label,
+            start_s,
+            within_a_step,
+            beyond_the_readings,
+            readings,
+            estimate.describe()
+        );
+    }
     CarriedEstimate { start_s, belief }
 }

@@ -18,6 +18,13 @@ use serde::{Deserialize, Serialize};
 /// for the profiles outside the fit's own models (onset/fit.rs), and a grid
 /// neighbour of the driver's model starts up to a step (0.1 s) away.
 pub const OBSERVATION_SD_S: f64 = 0.2;
+/// The prior probability that an observed start is not where the driver's
+/// model starts but misread, equally likely anywhere in its scene: a lesson's
+/// fit placed it off (a shape in no model, up to 1.3 s; 0075, 0079) or a wait was
+/// read as a decision. One start in twenty, stated, not fitted. Without it one
+/// misread start outweighs every other scene: a ttc-start user's estimate moved
+/// to a 0.7 s reaction and predicted 0.4 s late (0081).
+pub const MISREAD_START_PROBABILITY: f64 = 0.05;
 /// A driver is outside the model when no model of the grid predicts every
 /// observed start within this many [`OBSERVATION_SD_S`] (0.6 s): a start that far
 /// from every model's is not observation noise.
