@@ -144,17 +144,5 @@ pub(crate) fn start_beyond_readings(
         .sum();
     let predicts = beyond_the_readings >= CREDIBLE_MASS || within_a_step >= CREDIBLE_MASS;
     let start_s = (predicts && step < setup.situations.len()).then_some(step as f64 * setup.dt);
-    if std::env::var_os("PALC_DEBUG").is_some() && predicts {
-        let readings = crate::onset::predicted_start_s(setup, onsets, duration_s);
-        eprintln!(
-            "DBG {} | est {:?} sure {:.3} beyond {:.3} | readings {:?} | {}",
-            setup.label,
-            start_s,
-            within_a_step,
-            beyond_the_readings,
-            readings,
-            estimate.describe()
-        );
-    }
     CarriedEstimate { start_s, belief }
 }
