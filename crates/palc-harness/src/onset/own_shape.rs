@@ -60,34 +60,38 @@ impl OwnShape {
             let w = (t / dt - i as f64).clamp(0.0, 1.0);
             (driven_l[i] + w * (driven_l[i + 1] - driven_l[i])) / target_l
         };
-        let mut progress: Vec<f64> = (0..SAMPLES)
-            .map(|k| at(start_s + (end_s - start_s) * k as f64 / (SAMPLES - 1) as f64))
-            .collect();
-        let mut highest = 0.0f64;
-        for p in &mut progress {
-            highest = highest.max(p.clamp(0.0, 1.0));
-            *p = highest;
-        }
-        progress[0] = 0.0;
-        progress[SAMPLES - 1] = 1.0;
-        Some(OwnShape {
-            progress: progress.into(),
-        })
+        Some(OwnShape::held(
+            (0..SAMPLES)
+                .map(|k| at(start_s + (end_s - start_s) * k as f64 / (SAMPLES - 1) as f64))
+                .collect(),
+        ))
     }
 
     /// The shape of a lane-change model: `fraction(x)`, the fraction of the lane
     /// change done at the fraction `x` of its duration, sampled and held as
     /// [`OwnShape::seen`] holds a driven path.
     pub(crate) fn of_model(fraction: impl Fn(f64) -> f64) -> OwnShape {
+        OwnShape::held(
+            (0..SAMPLES)
+                .map(|k| fraction(k as f64 / (SAMPLES - 1) as f64))
+                .collect(),
+        )
+    }
+
+    /// Samples of the fraction done, held in [0, 1] and never decreasing, from 0
+    /// at the first to 1 at the last: what [`OwnLaneChange::validate`] requires.
+    fn held(mut progress: Vec<f64>) -> OwnShape {
         let mut highest = 0.0f64;
-        let mut progress: Vec<f64> = (0..SAMPLES)
-            .map(|k| {
-                highest = highest.max(fraction(k as f64 / (SAMPLES - 1) as f64).clamp(0.0, 1.0));
-                highest
-            })
-            .collect();
-        progress[0] = 0.0;
-        progress[SAMPLES - 1] = 1.0;
+        for p in &mut progress {
+            highest = highest.max(p.clamp(0.0, 1.0));
+            *p = highest;
+        }
+        if let Some(first) = progress.first_mut() {
+            *first = 0.0;
+        }
+        if let Some(last) = progress.last_mut() {
+            *last = 1.0;
+        }
         OwnShape {
             progress: progress.into(),
         }
