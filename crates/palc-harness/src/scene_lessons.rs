@@ -144,6 +144,7 @@ mod tests {
             target_l: 3.5,
             shape: crate::onset::Shape::QUINTIC,
             own: None,
+            onset: None,
         };
         let path = (0..120).map(|i| user.lateral(i as f64 * DT)).collect();
         (user, path)

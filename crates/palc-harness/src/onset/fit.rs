@@ -7,6 +7,7 @@
 //! (docs/experiments/0075-what-palc-believes-and-recorded-drivers.md).
 
 use super::own_shape::OwnShape;
+use super::power::PowerOnset;
 
 /// The root mean square distance (m) within which a lane-change model explains
 /// what the user drove: the fit through two crossings interpolated between 0.1 s
@@ -30,7 +31,7 @@ const MIN_FRACTION_SPAN: f64 = 0.2;
 /// The peak fractions the fit tries: where a lane change's lateral speed peaks,
 /// in the middle half of the move (0.5 is a symmetric profile), on a coarse grid
 /// refined once around the best of each base shape.
-const PEAK_RANGE: (f64, f64) = (0.25, 0.75);
+pub(super) const PEAK_RANGE: (f64, f64) = (0.25, 0.75);
 /// The latest takeover (as the fraction of the lane change the user had done)
 /// after which the peak is still fitted. The two bases differ most in the
 /// onset; seen only from later on, a skewed model of the wrong base fits as
@@ -179,6 +180,10 @@ pub(crate) struct UserLaneChange {
     /// The user's own shape, when it fitted better than every model; the lane
     /// change then follows it, not `shape`.
     pub own: Option<OwnShape>,
+    /// The onset extrapolated from what was seen, when neither the models nor
+    /// the user's own shape explained it ([`PowerOnset`]): the start is its, and
+    /// before the first step seen the lane change follows it.
+    pub onset: Option<PowerOnset>,
 }
 
 impl UserLaneChange {
@@ -233,6 +238,7 @@ impl UserLaneChange {
                 target_l,
                 shape,
                 own,
+                onset: None,
             };
             let error: f64 = (profile.iter().enumerate().skip(takeover_step))
                 .take_while(|&(i, _)| i as f64 * dt <= t_b)
@@ -289,7 +295,38 @@ impl UserLaneChange {
             }
             _ => best,
         };
-        Some(best.0)
+        if model_explains(best.1) {
+            return Some(best.0);
+        }
+        // Neither explains what the user drove: the onset's own law, when it
+        // explains the onset seen better than the lane change fitted as a whole.
+        let samples = PowerOnset::samples(&profile, takeover_step, dt);
+        let onset = PowerOnset::fit(&samples, dt, best.0.duration_s).filter(|onset| {
+            let fitted: f64 = (samples.iter())
+                .map(|&(t, p)| (best.0.lateral(t) / target_l - p).powi(2))
+                .sum();
+            let error = onset.squared_error(&samples);
+            error < fitted
+                && (error / samples.len() as f64).sqrt() * target_l.abs() <= MODEL_EXPLAINS_RMS_M
+        });
+        Some(match onset {
+            Some(onset) => best.0.with_onset(onset),
+            None => best.0,
+        })
+    }
+
+    /// This lane change started by `onset`, its end kept.
+    fn with_onset(self, onset: PowerOnset) -> UserLaneChange {
+        let end_s = self.start_s + self.duration_s;
+        if end_s <= onset.start_s {
+            return self;
+        }
+        UserLaneChange {
+            start_s: onset.start_s,
+            duration_s: end_s - onset.start_s,
+            onset: Some(onset),
+            ..self
+        }
     }
 
     /// [`UserLaneChange::fit`] to a lesson, where the user drove `driven_l`
@@ -373,6 +410,9 @@ impl UserLaneChange {
 
     /// The fitted lateral position (m) at time `t` (s): 0 before the start.
     pub(crate) fn lateral(&self, t: f64) -> f64 {
+        if let Some(onset) = self.onset.filter(|onset| t < onset.until_s) {
+            return self.target_l * onset.fraction(t);
+        }
         let x = ((t - self.start_s) / self.duration_s).clamp(0.0, 1.0);
         let done = match &self.own {
             Some(own) => own.fraction(x),
@@ -596,6 +636,37 @@ mod tests {
                 3.5 * (1.0 - (1.0 - x).powi(3))
             })
             .collect()
+    }
+
+    /// A lane change in neither base: its lateral speed rises linearly over the
+    /// first half (a quadratic onset, `2.4 x²`) and falls off as a square over
+    /// the second (`1 − 3.2 (1 − x)³`), position and speed continuous.
+    fn quadratic_onset(x: f64) -> f64 {
+        let x = x.clamp(0.0, 1.0);
+        if x <= 0.5 {
+            2.4 * x * x
+        } else {
+            1.0 - 3.2 * (1.0 - x).powi(3)
+        }
+    }
+
+    #[test]
+    fn the_start_of_a_shape_in_no_model_is_its_onsets() {
+        let (dt, start, duration) = (0.1, 4.23, 3.0);
+        let driven: Vec<f64> = (0..120)
+            .map(|i| 3.5 * quadratic_onset((i as f64 * dt - start) / duration))
+            .collect();
+        // Taken over at the paper's 0.3 m, already moving.
+        let takeover = driven.iter().position(|&l| l > 0.3).unwrap();
+        let fitted = UserLaneChange::fit_lesson(&driven, takeover, dt, 3.5, None).unwrap();
+        assert!(fitted.onset.is_some(), "{fitted:?}");
+        assert!((fitted.start_s - start).abs() < 0.03, "{fitted:?}");
+        // Before the takeover the path follows the onset, and meets what was
+        // driven within a centimetre.
+        let path = fitted.path(&driven, takeover, dt);
+        for (i, (got, want)) in path.iter().zip(&driven).enumerate().take(takeover + 1) {
+            assert!((got - want).abs() < 0.01, "step {i}: {got} vs {want}");
+        }
     }
 
     #[test]

@@ -14,7 +14,9 @@
 //! of a step; a profile outside the models (a table, a seventh-order polynomial)
 //! biases it by a few percent of its duration. Once a lesson has shown the user's
 //! whole lane change from rest, its own shape ([`OwnShape`]) is fitted beside the
-//! models in later lessons.
+//! models in later lessons. When neither explains what the user drove within a
+//! centimetre, the start is that of the onset's own power law fitted to the part
+//! of the onset seen (`power.rs`), when that law explains it.
 //!
 //! The relative state at that start ([`Onset`]: time headway, time to collision
 //! and gap to the vehicle ahead, and a target-lane gap when it held the user back)
@@ -42,6 +44,7 @@
 
 mod fit;
 mod own_shape;
+mod power;
 mod prediction;
 
 #[cfg(test)]
