@@ -100,6 +100,11 @@ pub(crate) fn starting_experience(
     let Some((anchor, start)) = anchored else {
         carried.weights = previous.weights_for(k, dt)?;
         carried.demonstration = None;
+        // The weights keep their time base: an anchor past this scene's horizon
+        // lies outside it, and an experience holding it would refuse every lesson.
+        carried.anchor_s = previous
+            .anchor_s
+            .filter(|a| (0.0..=k as f64 * dt).contains(a));
         return Ok(Carried {
             experience: carried,
             rehearsal: None,

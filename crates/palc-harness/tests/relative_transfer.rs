@@ -500,3 +500,52 @@ fn a_wait_for_the_follower_that_a_later_scene_contradicts_is_read_again_as_the_d
     let carried = run(&target, Some(&second), &mut NoObserver).expect("the run completes");
     assert_eq!(carried.summary.takeovers, 0);
 }
+
+#[test]
+fn an_anchor_past_a_new_scenes_horizon_is_not_carried() {
+    // Carried in the weights' own time base (the paper's representation), an
+    // experience learned where the user starts late would hold an anchor past a
+    // shorter scene's horizon, and every lesson there would be refused.
+    let cases = [
+        "collector-high",
+        "collector-slow",
+        "arterial-high",
+        "arterial-slow",
+    ];
+    let mut pairs = 0;
+    for source_case in cases {
+        let source = with_representation(
+            &config(source_case, 50.0, StylePreset::Neutral),
+            Representation::TimeIndexed,
+        );
+        let experience = learned_in(&source);
+        let anchor = experience.anchor_s.expect("a start was observed");
+        for target_case in cases {
+            let target = with_representation(
+                &config(target_case, 50.0, StylePreset::Neutral),
+                Representation::TimeIndexed,
+            );
+            let result =
+                run(&target, Some(&experience), &mut NoObserver).expect("the run completes");
+            if anchor > result.horizon as f64 * result.dt {
+                pairs += 1;
+                for record in &result.records {
+                    assert_eq!(
+                        record.learning_error, None,
+                        "{target_case} <- {source_case}"
+                    );
+                }
+                assert!(
+                    result
+                        .experience
+                        .anchor_s
+                        .is_some_and(|a| a <= result.horizon as f64 * result.dt)
+                );
+            }
+        }
+    }
+    assert!(
+        pairs > 0,
+        "no pair carries an anchor past the target's horizon"
+    );
+}
