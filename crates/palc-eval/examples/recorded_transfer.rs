@@ -78,12 +78,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let anchor = result.experience.anchor_s;
                 let error = own.zip(anchor).map(|(own, anchor)| anchor - own);
                 errors.extend(error);
+                // Where the first lesson came: its time, and whether the plan
+                // was ahead of the driver (the standard ALC started first).
+                let takeover = first.takeover.as_ref();
+                let ahead = takeover.map(|t| first.planned_l[t.step] > first.expected_l[t.step]);
                 println!(
-                    "{}: own start {} anchor {} error {}",
+                    "{}: own start {} anchor {} error {} | takeover at {} plan ahead {}",
                     spec.label(),
                     f(own),
                     f(anchor),
-                    f(error)
+                    f(error),
+                    f(takeover.map(|t| t.time_s)),
+                    ahead.map_or("-", |a| if a { "yes" } else { "no" })
                 );
             }
         }
@@ -109,13 +115,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .zip(tenth(&first.expected_l))
                     .map(|(planned, own)| planned - own);
                 errors.extend(error);
+                // How the source's start was read: a wait for the follower
+                // (the headway it started at, the follower's gap learned).
+                let onset = source.experience.onsets.last();
+                let wait = onset.and_then(|o| o.follower_wait_time_headway_s);
+                let lag = onset.and_then(|o| o.lag_time_gap_s);
                 println!(
-                    "{} <- {}: own start {} | plan at 10 % of the lane {} off | takeovers {}",
+                    "{} <- {}: own start {} | plan at 10 % of the lane {} off | takeovers {} | \
+                     follower wait at {} lag {}",
                     spec.label(),
                     source_spec.speed_case.name,
                     f(own_start_s(&first.expected_l, first.dt)),
                     f(error),
-                    target.summary.takeovers
+                    target.summary.takeovers,
+                    f(wait),
+                    f(lag)
                 );
             }
         }

@@ -442,6 +442,7 @@ mod tests {
             personalized: (4, 4),
             reduction: Some(0.25),
             refused: 0,
+            worse: 0,
         };
         let measured = Measured::Transfer(transfer);
         assert_eq!(claim.cell(&measured), "25 % (4.0 -> 3.0, 4 cells)");
@@ -454,6 +455,7 @@ mod tests {
             personalized: (0, 0),
             reduction: None,
             refused: 2,
+            worse: 0,
         });
         assert!(!claim.shown(&[none]));
     }

@@ -102,6 +102,8 @@ pub struct Transfer {
     pub reduction: Option<f64>,
     /// Transfer runs not counted (refused, or their source had no experience).
     pub refused: usize,
+    /// Pairs more than one takeover worse with experience than from scratch.
+    pub worse: usize,
 }
 
 /// Pairs each transfer run of `rows` with the grid run of its cell.
@@ -137,6 +139,9 @@ pub fn transfer_between(rows: &[&RunRow], without: Experiment, with: Experiment)
     }
     let mean = |v: &[f64]| (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64);
     let (without_mean, with_mean) = (mean(&without), mean(&with));
+    let worse = (without.iter().zip(&with))
+        .filter(|&(a, b)| *b > a + 1.0)
+        .count();
     Transfer {
         pairs: without.len(),
         without: without_mean,
@@ -147,6 +152,7 @@ pub fn transfer_between(rows: &[&RunRow], without: Experiment, with: Experiment)
             _ => None,
         },
         refused,
+        worse,
     }
 }
 

@@ -20,6 +20,7 @@ use crate::drive_report::{self, KindDrives};
 use crate::plan::Experiment;
 use crate::results::RunRow;
 use crate::stats::{self, Summary};
+use crate::targets::{TargetId, Verdict, target};
 
 /// The drive's band the table shows (lane changes, counted from 1).
 const DRIVE_BAND: (usize, usize) = (11, 50);
@@ -115,6 +116,23 @@ impl Section for Outside {
                     writeln!(out, "| {} |", line.join(" | "))?;
                 }
                 out.table(FILE, COLUMNS).rows.push(line);
+            }
+        }
+        writeln!(out)?;
+        // The goals for these drivers beyond the drive's (stated in its section).
+        let ids = [
+            TargetId::RecordedTransfer,
+            TargetId::OutOfClassTransfer,
+            TargetId::OutOfClassAccumulation,
+        ];
+        for target in ids.map(target) {
+            for &method in results.methods() {
+                let cases = target.cases(&results.index, method, results.input.user_kinds);
+                if target.judge(&cases) == Verdict::NotMeasured {
+                    continue;
+                }
+                let who = format!("`{}`, each user kind", method.name());
+                writeln!(out, "- {}", target.state_cases(&who, &cases))?;
             }
         }
         writeln!(out)

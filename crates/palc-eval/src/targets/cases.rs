@@ -30,7 +30,7 @@ impl Target {
             TargetId::TransferHeadway => {
                 transfer(index, method, Axis::Headway).map_or_else(Vec::new, whole)
             }
-            TargetId::Accumulation => accumulation(index, method),
+            TargetId::Accumulation => accumulation(index, method, 1, |_| true),
             TargetId::KindsLearned => (kinds.iter())
                 .filter_map(|kind| {
                     let s = Summary::of(index.grid(method, &kind.name).iter().copied());
@@ -91,6 +91,34 @@ impl Target {
                 !k.has_spread() && !k.is_out_of_class()
             }),
             TargetId::DriveOutOfClass => drive(index, method, kinds, UserKind::is_out_of_class),
+            TargetId::RecordedTransfer => (kinds.iter())
+                .filter(|kind| kind.recorded.is_some())
+                .filter_map(|kind| {
+                    let t = stats::transfer(&index.with_transfer(method, &kind.name));
+                    (t.pairs > 0).then(|| case(kind, Measured::Reduction(t.reduction)))
+                })
+                .collect(),
+            TargetId::OutOfClassTransfer => (kinds.iter())
+                .filter(|kind| out_of_class_family(kind))
+                .filter_map(|kind| {
+                    let t = stats::transfer(&index.with_transfer(method, &kind.name));
+                    (t.pairs > 0).then(|| {
+                        let pairs = Pairs {
+                            pairs: t.pairs,
+                            without: t.without,
+                            with: t.with,
+                            worse: t.worse,
+                            capped: t.pairs - t.personalized.1,
+                        };
+                        case(kind, Measured::Transfer(pairs))
+                    })
+                })
+                .collect(),
+            TargetId::OutOfClassAccumulation => {
+                let family =
+                    |name: &str| (kinds.iter()).any(|k| k.name == name && out_of_class_family(k));
+                accumulation(index, method, 2, family)
+            }
         }
     }
 }
@@ -112,6 +140,12 @@ fn drive(
             (driven > 0).then(|| case(kind, Measured::TakenOver { taken, driven }))
         })
         .collect()
+}
+
+/// A simulated family outside the one-cue rules (MOBIL's incentive, two cues):
+/// the out-of-class families, whose goals differ from recorded drivers'.
+fn out_of_class_family(kind: &UserKind) -> bool {
+    kind.is_out_of_class() && kind.recorded.is_none()
 }
 
 /// A case of one user kind.
@@ -139,17 +173,26 @@ pub fn transfer(index: &Indexed, method: Method, axis: Axis) -> Option<Measured>
     }))
 }
 
-/// The accumulation chains of `method`: one case per axis and user kind, the
-/// mean takeovers after the first scene.
-fn accumulation(index: &Indexed, method: Method) -> Vec<Case> {
+/// The accumulation chains of `method`: one case per axis and user kind that
+/// `includes` (by name), the mean takeovers per scene after the first
+/// `after_scenes` of each chain (`None` when no chain is that long).
+fn accumulation(
+    index: &Indexed,
+    method: Method,
+    after_scenes: usize,
+    includes: impl Fn(&str) -> bool,
+) -> Vec<Case> {
     let mut cases = Vec::new();
     for axis in Axis::BOTH {
         let kinds = scenes::accumulation_places(index.rows(), method, axis);
         if kinds.iter().map(|(_, p)| p.len()).max().unwrap_or(0) < 2 {
             continue;
         }
-        for (name, places) in kinds {
-            let following: Vec<f64> = places.iter().skip(1).flatten().copied().collect();
+        for (name, places) in kinds.into_iter().filter(|(name, _)| includes(name)) {
+            let following: Vec<f64> = (places.iter().skip(after_scenes))
+                .flatten()
+                .copied()
+                .collect();
             cases.push(Case {
                 who: format!("{name}, {}s", axis.name()),
                 measured: Measured::Takeovers(scenes::mean(&following)),

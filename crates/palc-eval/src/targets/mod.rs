@@ -56,6 +56,14 @@ pub enum TargetId {
     DriveOwnFamilies,
     /// A drive of varied scenes, drivers outside the one-cue rules.
     DriveOutOfClass,
+    /// Recorded drivers' transfer from the transfer experiment's other scene.
+    RecordedTransfer,
+    /// Families outside the one-cue rules: experience from one other scene
+    /// never much worse than none.
+    OutOfClassTransfer,
+    /// Families outside the one-cue rules through the scenes in sequence, once
+    /// two scenes are behind.
+    OutOfClassAccumulation,
 }
 
 /// How a measurement is judged.
@@ -64,8 +72,18 @@ pub enum Rule {
     /// Experience: the mean takeovers at least this much lower (relative), no
     /// pair more than one takeover worse, every run with experience personalized.
     Transfer(f64),
-    /// A mean of at most this many takeovers.
-    AtMostTakeovers(f64),
+    /// A mean of at most `takeovers` per scene over the scenes that follow the
+    /// first `after_scenes` of a chain.
+    AtMostTakeovers {
+        /// Bound of the mean takeovers per scene.
+        takeovers: f64,
+        /// Scenes of each chain not counted: the experience they built is
+        /// what is judged.
+        after_scenes: usize,
+    },
+    /// No pair of a transfer more than one takeover worse with experience than
+    /// from scratch.
+    NoPairWorse,
     /// At least this share of the counted runs.
     Share(f64),
     /// A relative reduction of the mean takeovers of at least this.
@@ -111,7 +129,10 @@ pub const TARGETS: &[Target] = &[
         id: TargetId::Accumulation,
         name: "one user through the scenes in sequence",
         how: "mean takeovers after the first scene of each chain, per user kind and axis",
-        rule: Rule::AtMostTakeovers(0.5),
+        rule: Rule::AtMostTakeovers {
+            takeovers: 0.5,
+            after_scenes: 1,
+        },
         source: "docs/experiments/0047-relative-onset-measured.md",
     },
     Target {
@@ -177,6 +198,33 @@ pub const TARGETS: &[Target] = &[
               that starts on MOBIL's incentive or on two cues",
         rule: Rule::AtMostTakenOver(0.20),
         source: "docs/experiments/0073-a-drive-of-varied-scenes.md",
+    },
+    Target {
+        id: TargetId::RecordedTransfer,
+        name: "recorded drivers gain from experience",
+        how: "1 - with / without over the cells where the transfer run (experience of `[transfer] source`) and the grid run \
+              were counted, per recorded user kind",
+        rule: Rule::Reduction(0.5),
+        source: "docs/experiments/0084-the-goals-for-drivers-outside-the-model-as-targets.md",
+    },
+    Target {
+        id: TargetId::OutOfClassTransfer,
+        name: "families outside the one-cue rules, experience from one other scene",
+        how: "the transfer runs against the grid runs of their cells, both counted, per simulated user kind that starts on \
+              MOBIL's incentive or on two cues",
+        rule: Rule::NoPairWorse,
+        source: "docs/experiments/0084-the-goals-for-drivers-outside-the-model-as-targets.md",
+    },
+    Target {
+        id: TargetId::OutOfClassAccumulation,
+        name: "families outside the one-cue rules through the scenes in sequence",
+        how: "mean takeovers per scene after the first two of each chain, per simulated user kind that starts on MOBIL's \
+              incentive or on two cues, and axis",
+        rule: Rule::AtMostTakeovers {
+            takeovers: 0.5,
+            after_scenes: 2,
+        },
+        source: "docs/experiments/0084-the-goals-for-drivers-outside-the-model-as-targets.md",
     },
 ];
 
@@ -316,7 +364,20 @@ impl Rule {
                 "at least {:.0} % fewer takeovers, no pair worse by more than one, every run personalized",
                 100.0 * r
             ),
-            Rule::AtMostTakeovers(v) => format!("at most {v} takeovers after the first scene"),
+            Rule::AtMostTakeovers {
+                takeovers,
+                after_scenes,
+            } => {
+                let first = match after_scenes {
+                    1 => "the first scene".to_owned(),
+                    2 => "the first two scenes".to_owned(),
+                    n => format!("the first {n} scenes"),
+                };
+                format!("at most {takeovers} takeovers after {first}")
+            }
+            Rule::NoPairWorse => {
+                "no pair worse than from scratch by more than one takeover".to_owned()
+            }
             Rule::Share(s) => format!("at least {:.0} % of the counted runs", 100.0 * s),
             Rule::Reduction(r) => format!("at least {:.0} % fewer takeovers", 100.0 * r),
             Rule::LikeOpenLoop { points, takeovers } => format!(
@@ -344,7 +405,10 @@ impl Target {
                 None if p.pairs == 0 => return Verdict::NotMeasured,
                 reduction => reduction.is_some_and(|x| x >= r) && p.worse == 0 && p.capped == 0,
             },
-            (Rule::AtMostTakeovers(bound), Measured::Takeovers(Some(v))) => *v <= bound,
+            (Rule::AtMostTakeovers { takeovers, .. }, Measured::Takeovers(Some(v))) => {
+                *v <= takeovers
+            }
+            (Rule::NoPairWorse, Measured::Transfer(p)) if p.pairs > 0 => p.worse == 0,
             (Rule::Share(share), Measured::Share { hits, runs }) if *runs > 0 => {
                 *hits as f64 >= share * *runs as f64 - SHARE_TOLERANCE
             }
@@ -536,6 +600,34 @@ mod tests {
             capped: 0,
         });
         assert_eq!(t.verdict(&none), Verdict::NotMeasured);
+    }
+
+    #[test]
+    fn an_out_of_class_transfer_is_judged_on_its_worst_pair_alone() {
+        let t = target(TargetId::OutOfClassTransfer);
+        // No gain, even a loss, is met while no pair is worse by more than one.
+        assert_eq!(t.verdict(&pairs(1.0, 1.4, 0, 2)), Verdict::Met);
+        assert_eq!(t.verdict(&pairs(1.0, 0.2, 1, 0)), Verdict::NotMet);
+        let none = Measured::Transfer(Pairs {
+            pairs: 0,
+            without: None,
+            with: None,
+            worse: 0,
+            capped: 0,
+        });
+        assert_eq!(t.verdict(&none), Verdict::NotMeasured);
+    }
+
+    #[test]
+    fn accumulation_after_two_scenes_says_so() {
+        let t = target(TargetId::OutOfClassAccumulation);
+        assert_eq!(
+            t.rule.describe(),
+            "at most 0.5 takeovers after the first two scenes"
+        );
+        assert_eq!(t.verdict(&Measured::Takeovers(Some(0.5))), Verdict::Met);
+        assert_eq!(t.verdict(&Measured::Takeovers(Some(0.51))), Verdict::NotMet);
+        assert_eq!(t.verdict(&Measured::Takeovers(None)), Verdict::NotMeasured);
     }
 
     #[test]
