@@ -20,21 +20,29 @@ const NEVER: u32 = u32::MAX;
 /// about -745.13), so a weight this far below the top is 0 without the call.
 const EXP_UNDERFLOW: f64 = -746.0;
 
-/// The grid of start models: every threshold of every cue, crossed with every
-/// reaction and pair of accepted gaps. Hypothesis `h` is threshold
-/// `h % thresholds` of combination `h / thresholds`.
+/// The grid of start models: every threshold of every one-cue decision,
+/// crossed with every reaction and pair of accepted gaps (hypothesis `h` below
+/// [`Grid::single`] is threshold `h % thresholds` of combination
+/// `h / thresholds`), then every threshold pair of the two-cue decision
+/// ([`prior::paired_thresholds`]) crossed with every pair of accepted gaps,
+/// without reaction (hypothesis `single + g * pairs + p` is pair `p` of gap
+/// pair `g`).
 #[derive(Debug, Clone)]
 struct Grid {
-    /// Each cue with the index of its first threshold and its thresholds.
+    /// Each one-cue decision with the index of its first threshold and its
+    /// thresholds.
     cues: Vec<(Cue, usize, Vec<f64>)>,
-    /// All thresholds, of every cue.
+    /// All thresholds, of every one-cue decision.
     thresholds: usize,
+    /// The two-cue decision's pairs, as indices of all thresholds: the time
+    /// headway's and the time to collision's.
+    pairs: Vec<(usize, usize)>,
 }
 
 impl Grid {
     fn new() -> Grid {
         let mut offset = 0;
-        let cues = (Cue::ALL.iter())
+        let cues: Vec<(Cue, usize, Vec<f64>)> = (Cue::SINGLE.iter())
             .map(|&cue| {
                 let thresholds = cue.thresholds();
                 let first = offset;
@@ -42,18 +50,37 @@ impl Grid {
                 (cue, first, thresholds)
             })
             .collect();
+        let first = |wanted: Cue| {
+            (cues.iter())
+                .find(|(cue, _, _)| *cue == wanted)
+                .map_or(0, |(_, first, _)| *first)
+        };
+        let (headway, ttc) = (first(Cue::TimeHeadway), first(Cue::TimeToCollision));
+        let pairs = (prior::paired_thresholds().into_iter())
+            .map(|(h, t)| (headway + h, ttc + t))
+            .collect();
         Grid {
             cues,
             thresholds: offset,
+            pairs,
         }
     }
 
     fn combinations() -> usize {
-        REACTIONS_S.len() * LEAD_GAPS_S.len() * LAG_GAPS_S.len()
+        REACTIONS_S.len() * Grid::gap_combinations()
+    }
+
+    fn gap_combinations() -> usize {
+        LEAD_GAPS_S.len() * LAG_GAPS_S.len()
+    }
+
+    /// The hypotheses of one-cue decisions, which come first.
+    fn single(&self) -> usize {
+        self.thresholds * Grid::combinations()
     }
 
     fn len(&self) -> usize {
-        self.thresholds * Grid::combinations()
+        self.single() + self.pairs.len() * Grid::gap_combinations()
     }
 
     /// The cue and threshold of threshold index `t` (below `self.thresholds`).
@@ -70,8 +97,31 @@ impl Grid {
         (*cue, thresholds[thresholds.len() - 1])
     }
 
+    /// The cue of hypothesis `h`.
+    fn cue(&self, h: usize) -> Cue {
+        if h < self.single() {
+            self.threshold(h % self.thresholds).0
+        } else {
+            Cue::HeadwayOrTtc
+        }
+    }
+
     /// The start model of hypothesis `h`.
     fn model(&self, h: usize) -> StartModel {
+        if h >= self.single() {
+            let k = h - self.single();
+            let (headway, ttc) = self.pairs[k % self.pairs.len()];
+            let (rule, time_headway_s) =
+                Cue::paired_rule(self.threshold(headway).1, self.threshold(ttc).1);
+            let (lead, lag) = gap_combination(k / self.pairs.len());
+            return StartModel {
+                rule,
+                time_headway_s,
+                reaction_s: 0.0,
+                min_lead_gap_s: lead,
+                min_lag_gap_s: lag,
+            };
+        }
         let (cue, threshold) = self.threshold(h % self.thresholds);
         let (rule, time_headway_s) = cue.rule(threshold);
         let (reaction_s, min_lead_gap_s, min_lag_gap_s) = combination(h / self.thresholds);
@@ -98,14 +148,15 @@ impl Grid {
     /// step in a scene ([`NEVER`] for none): the fast form of
     /// [`StartModel::start_step`] (a test checks the two agree), sharing each
     /// threshold's decision step across the combinations and each pair of gaps'
-    /// next acceptable step across the reactions. `hypotheses` are consecutive
-    /// thresholds of one combination that decide at the same step, and so start
-    /// at the same step. A model that has decided at the scene's first step never
-    /// starts in it: its driver would have changed lanes before the system
-    /// planned (palc-user refuses such a scene for a simulated user).
+    /// next acceptable step across the reactions and the two-cue pairs.
+    /// `hypotheses` are consecutive hypotheses that start at the same step. A
+    /// model that has decided at the scene's first step never starts in it: its
+    /// driver would have changed lanes before the system planned (palc-user
+    /// refuses such a scene for a simulated user).
     fn for_each_start(&self, scene: &SceneView<'_>, mut visit: impl FnMut(Range<usize>, u32)) {
         let n = scene.situations.len();
-        let mut decision = vec![NEVER; self.thresholds];
+        // The first step at which each threshold decides (`n` for never).
+        let mut decided_at = vec![n as u32; self.thresholds];
         for (cue, first, thresholds) in &self.cues {
             let mut running = f64::NEG_INFINITY;
             let most_urgent: Vec<f64> = (scene.situations.iter())
@@ -116,12 +167,17 @@ impl Grid {
                 .collect();
             for (j, &threshold) in thresholds.iter().enumerate() {
                 let key = cue.key(threshold);
-                let step = most_urgent.partition_point(|&u| u < key);
-                if step > 0 && step < n {
-                    decision[first + j] = step as u32;
-                }
+                decided_at[first + j] = most_urgent.partition_point(|&u| u < key) as u32;
             }
         }
+        let starts_from = |step: u32| (step > 0 && (step as usize) < n).then_some(step);
+        let decision: Vec<u32> = (decided_at.iter())
+            .map(|&step| starts_from(step).unwrap_or(NEVER))
+            .collect();
+        // A two-cue driver decides at the earlier of its two cues' decisions.
+        let paired: Vec<u32> = (self.pairs.iter())
+            .map(|&(h, t)| starts_from(decided_at[h].min(decided_at[t])).unwrap_or(NEVER))
+            .collect();
         // The thresholds in runs of the same decision step.
         let mut runs: Vec<(Range<usize>, u32)> = Vec::new();
         for (t, &decided) in decision.iter().enumerate() {
@@ -142,22 +198,50 @@ impl Grid {
                     let open = gaps.accepts(&scene.situations[i]) && scene.safe_through[i];
                     next[i] = if open { i as u32 } else { next[i + 1] };
                 }
+                let start_after = |decided: u32, reaction: usize| {
+                    if decided != NEVER {
+                        next[(decided as usize).saturating_add(reaction).min(n)]
+                    } else {
+                        NEVER
+                    }
+                };
                 for (reaction_index, &reaction_s) in REACTIONS_S.iter().enumerate() {
                     let reaction = StartModel { reaction_s, ..gaps }.reaction_steps(scene.dt);
                     let c = combination_index(reaction_index, lead_index, lag_index);
                     let offset = c * self.thresholds;
                     for (thresholds, decided) in &runs {
-                        let start = if *decided != NEVER {
-                            next[(*decided as usize).saturating_add(reaction).min(n)]
-                        } else {
-                            NEVER
-                        };
+                        let start = start_after(*decided, reaction);
                         visit(offset + thresholds.start..offset + thresholds.end, start);
                     }
+                }
+                let g = lead_index * LAG_GAPS_S.len() + lag_index;
+                let offset = self.single() + g * self.pairs.len();
+                let mut run: Option<(usize, u32)> = None;
+                for (p, &decided) in paired.iter().enumerate() {
+                    let start = start_after(decided, 0);
+                    match run {
+                        Some((_, step)) if step == start => {}
+                        Some((first, step)) => {
+                            visit(offset + first..offset + p, step);
+                            run = Some((p, start));
+                        }
+                        None => run = Some((p, start)),
+                    }
+                }
+                if let Some((first, step)) = run {
+                    visit(offset + first..offset + self.pairs.len(), step);
                 }
             }
         }
     }
+}
+
+/// The accepted lead and lag gaps of gap pair `g` (the lag's the inner index).
+fn gap_combination(g: usize) -> (f64, f64) {
+    (
+        LEAD_GAPS_S[g / LAG_GAPS_S.len()],
+        LAG_GAPS_S[g % LAG_GAPS_S.len()],
+    )
 }
 
 /// The reaction and gaps of combination `c`.
@@ -215,7 +299,7 @@ impl<'a> SceneView<'a> {
 
 /// How far each start step of a scene lies from the observed start, and the
 /// log-likelihood it costs: computed once per step (a scene has a few hundred)
-/// rather than once per hypothesis (a million), with the same arithmetic.
+/// rather than once per hypothesis (1.6 million), with the same arithmetic.
 struct Misfit {
     /// `(error_s, penalty)` per start step; the last entry is for [`NEVER`].
     per_step: Vec<(f64, f64)>,
@@ -387,25 +471,31 @@ impl DriverEstimate {
             );
         }
         let h = self.most_probable_index();
-        let (cue, threshold) = self.grid.threshold(h % self.grid.thresholds);
+        let cue = self.grid.cue(h);
         let model = self.grid.model(h);
-        let unit = match cue {
-            Cue::TimeHeadway | Cue::TimeToCollision => "s",
-            Cue::DistanceGap => "m",
-            Cue::Incentive => "m/s²",
+        let decision = match (cue, model.rule) {
+            (Cue::HeadwayOrTtc, palc_user::StartRule::HeadwayOrTtc { ttc_seconds }) => format!(
+                "the time headway at {:.2} s or the time to collision at {ttc_seconds:.2} s",
+                model.time_headway_s
+            ),
+            _ => {
+                let threshold = self.grid.threshold(h % self.grid.thresholds).1;
+                let unit = match cue {
+                    Cue::DistanceGap => "m",
+                    Cue::Incentive => "m/s²",
+                    _ => "s",
+                };
+                format!("the {} at {threshold:.2} {unit}", cue.name())
+            }
         };
         let mass = (self.cue_masses().into_iter())
             .find(|(name, _)| *name == cue.name())
             .map_or(0.0, |(_, mass)| mass);
         format!(
-            "decides on the {} at {threshold:.2} {unit} (posterior mass of the cue {mass:.2}), \
+            "decides on {decision} (posterior mass of the cue {mass:.2}), \
              reacts in {:.1} s, accepts lead gaps from {:.1} s and lag gaps from {:.2} s \
              (scenes seen: {})",
-            cue.name(),
-            model.reaction_s,
-            model.min_lead_gap_s,
-            model.min_lag_gap_s,
-            self.scenes
+            model.reaction_s, model.min_lead_gap_s, model.min_lag_gap_s, self.scenes
         )
     }
 
@@ -416,7 +506,7 @@ impl DriverEstimate {
             (masses.iter().enumerate()).fold((0, f64::NEG_INFINITY), |best, (i, &(_, m))| {
                 if m > best.1 { (i, m) } else { best }
             });
-        (self.grid.cues[i].0, mass)
+        (Cue::ALL[i], mass)
     }
 
     /// The posterior mass of each cue.
@@ -438,8 +528,15 @@ impl DriverEstimate {
                 }
             }
         }
-        (self.grid.cues.iter().zip(masses))
-            .map(|((cue, _, _), mass)| (cue.name(), if total > 0.0 { mass / total } else { 0.0 }))
+        let mut paired = -0.0;
+        for &lp in &self.log_posterior[self.grid.single()..] {
+            let weight = weight(lp, top);
+            total += weight;
+            paired += weight;
+        }
+        let cues = (self.grid.cues.iter().map(|(cue, _, _)| *cue)).chain([Cue::HeadwayOrTtc]);
+        (cues.zip(masses.into_iter().chain([paired])))
+            .map(|(cue, mass)| (cue.name(), if total > 0.0 { mass / total } else { 0.0 }))
             .collect()
     }
 
@@ -460,6 +557,14 @@ impl DriverEstimate {
                     mass += cue_mass;
                 }
             }
+        }
+        // The two-cue decisions, without reaction.
+        let paired: f64 = (self.log_posterior[self.grid.single()..].iter())
+            .map(|&lp| weight(lp, top))
+            .sum();
+        total += paired;
+        if holds(Cue::HeadwayOrTtc, 0.0) {
+            mass += paired;
         }
         if total > 0.0 { mass / total } else { 0.0 }
     }
@@ -542,9 +647,10 @@ fn weight(lp: f64, top: f64) -> f64 {
     }
 }
 
-/// The log prior: each cue [`prior::cue_mass`], uniform over its thresholds;
-/// the reaction and the accepted gaps independent, each exponential on its grid
-/// with scale [`prior::DEMAND_SCALE_S`].
+/// The log prior: each cue [`prior::cue_mass`], uniform over its thresholds
+/// (the two-cue decision's: over its pairs); the reaction (none for two cues)
+/// and the accepted gaps independent, each exponential on its grid with scale
+/// [`prior::DEMAND_SCALE_S`].
 fn prior(grid: &Grid) -> Vec<f64> {
     let per_threshold: Vec<f64> = (grid.cues.iter())
         .flat_map(|(cue, _, thresholds)| {
@@ -569,6 +675,13 @@ fn prior(grid: &Grid) -> Vec<f64> {
                 let combination = reaction + lead + lag;
                 log_prior.extend(per_threshold.iter().map(|t| t + combination));
             }
+        }
+    }
+    // The two-cue decisions: uniform over the pairs, no reaction.
+    let per_pair = prior::cue_mass(Cue::HeadwayOrTtc).ln() - (grid.pairs.len() as f64).ln();
+    for lead in &leads {
+        for lag in &lags {
+            log_prior.extend(std::iter::repeat_n(per_pair + lead + lag, grid.pairs.len()));
         }
     }
     log_prior
@@ -659,7 +772,7 @@ mod tests {
         /// rules the truth out, and never calls such a driver outside the model.
         #[test]
         fn a_driver_of_the_grid_is_never_ruled_out(
-            h in 0usize..400_000,
+            h in 0usize..2_000_000,
             order in proptest::sample::subsequence(vec![0usize, 1, 2, 3], 1..=4),
         ) {
             let grid = Grid::new();
@@ -838,6 +951,65 @@ mod tests {
         let belief = carried.belief.expect("two recorded scenes or more");
         assert_eq!(belief.scenes, seen.len());
         assert!(!belief.outside_model);
+    }
+
+    #[test]
+    fn a_driver_on_two_cues_is_inside_the_model_and_singled_out() {
+        // The two-cue driver of the grid nearest a headway of 1.5 s or a time to
+        // collision of 8 s, whichever comes first, accepting any gap.
+        let grid = Grid::new();
+        let (h, _) = (grid.single()..grid.single() + grid.pairs.len())
+            .map(|h| {
+                let model = grid.model(h);
+                let palc_user::StartRule::HeadwayOrTtc { ttc_seconds } = model.rule else {
+                    unreachable!("the pairs' block holds two-cue models");
+                };
+                (
+                    h,
+                    (model.time_headway_s - 1.5).abs() + (ttc_seconds - 8.0).abs() / 8.0,
+                )
+            })
+            .fold(
+                (0, f64::INFINITY),
+                |best, (h, d)| if d < best.1 { (h, d) } else { best },
+            );
+        let driver = grid.model(h);
+        assert_eq!((driver.min_lead_gap_s, driver.min_lag_gap_s), (0.0, 0.0));
+        let setups = more_scenes();
+        let onsets: Vec<Onset> = (setups.iter())
+            .filter_map(|setup| observed(&driver, setup))
+            .collect();
+        // Each cue alone misses some of these starts: the scenes need both.
+        for cue in [Cue::TimeHeadway, Cue::TimeToCollision] {
+            let threshold = match (cue, driver.rule) {
+                (Cue::TimeToCollision, palc_user::StartRule::HeadwayOrTtc { ttc_seconds }) => {
+                    ttc_seconds
+                }
+                _ => driver.time_headway_s,
+            };
+            let (rule, time_headway_s) = cue.rule(threshold);
+            let alone = StartModel {
+                rule,
+                time_headway_s,
+                ..driver
+            };
+            let differs = (setups.iter()).any(|setup| {
+                observed(&alone, setup).map(|o| o.time_s)
+                    != observed(&driver, setup).map(|o| o.time_s)
+            });
+            assert!(differs, "{cue:?} alone starts as the driver in every scene");
+        }
+        let estimate = DriverEstimate::from_onsets(&onsets, 2.0).unwrap();
+        assert!(!estimate.outside_model(), "{}", estimate.describe());
+        let (cue, mass) = estimate.dominant_cue();
+        assert_eq!(cue, Cue::HeadwayOrTtc, "{}", estimate.describe());
+        assert!(
+            mass >= super::super::CREDIBLE_MASS,
+            "{}",
+            estimate.describe()
+        );
+        let log_likelihood = estimate.log_posterior[h] - prior(&grid)[h];
+        assert!(log_likelihood.abs() < 1e-9, "{log_likelihood}");
     }
 
     #[test]

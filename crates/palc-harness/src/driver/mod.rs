@@ -7,8 +7,10 @@
 //! step ([`palc_aggregator::SceneSteps`], recorded with the scene's onset). The
 //! estimate ([`DriverEstimate`]) is a posterior over a grid of start models
 //! ([`prior`]): the cue the decision is taken on (time headway, time to
-//! collision, distance gap, or MOBIL's incentive) with its threshold, the
-//! reaction, and the lead and lag gaps accepted. A model's likelihood in a scene
+//! collision, distance gap, or MOBIL's incentive) with its threshold, or two
+//! cues at once (the first of the time headway and the time to collision to
+//! fall to its threshold, [`prior::Cue::HeadwayOrTtc`]), the reaction, and the
+//! lead and lag gaps accepted. A model's likelihood in a scene
 //! compares the start it predicts there, run forward over every step, with the
 //! start observed (Gaussian, [`prior::OBSERVATION_SD_S`], or misread anywhere
 //! in the scene with [`prior::MISREAD_START_PROBABILITY`]): a model that would have
