@@ -1008,6 +1008,12 @@ mod tests {
             "{}",
             estimate.describe()
         );
+        let said = estimate.describe();
+        assert!(
+            said.starts_with("decides on the time headway at")
+                && said.contains("or the time to collision at"),
+            "{said}"
+        );
         let log_likelihood = estimate.log_posterior[h] - prior(&grid)[h];
         assert!(log_likelihood.abs() < 1e-9, "{log_likelihood}");
     }
