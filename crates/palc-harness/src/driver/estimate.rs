@@ -380,13 +380,14 @@ pub enum Prediction {
 #[derive(Debug, Clone)]
 pub struct DriverEstimate {
     grid: Grid,
-    /// Unnormalized log posterior per hypothesis.
-    log_posterior: Vec<f64>,
+    /// The posterior as accumulated over the scenes (shared with the memo).
+    posterior: Arc<Accumulated>,
+    /// The posterior weight of each hypothesis, the largest 1: every mass the
+    /// estimate reports is a sum of these, computed once per estimate.
+    weights: Vec<f64>,
     /// The smallest, over hypotheses, of the largest distance (s) between a
     /// scene's observed start and the hypothesis's.
     closest_s: f64,
-    /// Scenes observed.
-    scenes: usize,
 }
 
 impl DriverEstimate {
@@ -401,29 +402,39 @@ impl DriverEstimate {
         let grid = Grid::new();
         // A posterior of the first scenes, kept from an earlier estimate, is
         // extended with the rest: the same sum, in the same order.
-        let (mut accumulated, read) = match memo::longest_beginning(&seen, duration_s) {
-            Some((kept, read)) => (Accumulated::clone(&kept), read),
-            None => (
-                Accumulated {
-                    log_posterior: prior(&grid),
-                    worst: vec![0.0f64; grid.len()],
-                    scenes: 0,
-                },
-                0,
-            ),
+        let kept = memo::longest_beginning(&seen, duration_s);
+        let posterior = match kept {
+            Some((kept, read)) if read == seen.len() => kept,
+            kept => {
+                let (mut accumulated, read) = match kept {
+                    Some((kept, read)) => (Accumulated::clone(&kept), read),
+                    None => (
+                        Accumulated {
+                            log_posterior: prior(&grid),
+                            worst: vec![0.0f64; grid.len()],
+                            scenes: 0,
+                        },
+                        0,
+                    ),
+                };
+                for onset in &seen[read..] {
+                    accumulated.read(&grid, onset, duration_s);
+                }
+                let accumulated = Arc::new(accumulated);
+                memo::keep(&seen, duration_s, Arc::clone(&accumulated));
+                accumulated
+            }
         };
-        for onset in &seen[read..] {
-            accumulated.read(&grid, onset, duration_s);
-        }
-        if read < seen.len() {
-            memo::keep(&seen, duration_s, Arc::new(accumulated.clone()));
-        }
-        let closest_s = (accumulated.worst.iter().copied()).fold(f64::INFINITY, f64::min);
+        let closest_s = (posterior.worst.iter().copied()).fold(f64::INFINITY, f64::min);
+        let top = (posterior.log_posterior.iter().copied()).fold(f64::NEG_INFINITY, f64::max);
+        let weights = (posterior.log_posterior.iter())
+            .map(|&lp| weight(lp, top))
+            .collect();
         Some(DriverEstimate {
             grid,
-            log_posterior: accumulated.log_posterior,
+            posterior,
+            weights,
             closest_s,
-            scenes: accumulated.scenes,
         })
     }
 
@@ -436,7 +447,7 @@ impl DriverEstimate {
 
     /// Scenes the estimate has seen.
     pub fn scenes(&self) -> usize {
-        self.scenes
+        self.posterior.scenes
     }
 
     /// The posterior's most probable start model: among equals, the first of
@@ -448,7 +459,7 @@ impl DriverEstimate {
     }
 
     fn most_probable_index(&self) -> usize {
-        let (h, _) = (self.log_posterior.iter().enumerate()).fold(
+        let (h, _) = (self.posterior.log_posterior.iter().enumerate()).fold(
             (0, f64::NEG_INFINITY),
             |best, (h, &lp)| {
                 if lp > best.1 + 1e-12 { (h, lp) } else { best }
@@ -466,7 +477,7 @@ impl DriverEstimate {
                 "outside the model: no start model within {:.2} s of every start \
                  (scenes seen: {}, closest {:.2} s)",
                 MISFIT_SDS * OBSERVATION_SD_S,
-                self.scenes,
+                self.scenes(),
                 self.closest_s
             );
         }
@@ -495,7 +506,10 @@ impl DriverEstimate {
             "decides on {decision} (posterior mass of the cue {mass:.2}), \
              reacts in {:.1} s, accepts lead gaps from {:.1} s and lag gaps from {:.2} s \
              (scenes seen: {})",
-            model.reaction_s, model.min_lead_gap_s, model.min_lag_gap_s, self.scenes
+            model.reaction_s,
+            model.min_lead_gap_s,
+            model.min_lag_gap_s,
+            self.scenes()
         )
     }
 
@@ -511,7 +525,6 @@ impl DriverEstimate {
 
     /// The posterior mass of each cue.
     pub fn cue_masses(&self) -> Vec<(&'static str, f64)> {
-        let top = self.top();
         let nt = self.grid.thresholds;
         // One pass in hypothesis order: the total and each cue's mass add their
         // weights in the order of a sum over the weights (the cues' thresholds
@@ -521,16 +534,14 @@ impl DriverEstimate {
         for c in 0..Grid::combinations() {
             for ((_, first, thresholds), mass) in self.grid.cues.iter().zip(&mut masses) {
                 let start = c * nt + first;
-                for &lp in &self.log_posterior[start..start + thresholds.len()] {
-                    let weight = weight(lp, top);
+                for &weight in &self.weights[start..start + thresholds.len()] {
                     total += weight;
                     *mass += weight;
                 }
             }
         }
         let mut paired = -0.0;
-        for &lp in &self.log_posterior[self.grid.single()..] {
-            let weight = weight(lp, top);
+        for &weight in &self.weights[self.grid.single()..] {
             total += weight;
             paired += weight;
         }
@@ -542,16 +553,13 @@ impl DriverEstimate {
 
     /// The posterior mass of the start models for which `holds(cue, reaction_s)`.
     pub fn mass_where(&self, holds: impl Fn(Cue, f64) -> bool) -> f64 {
-        let top = self.top();
         let nt = self.grid.thresholds;
         let (mut total, mut mass) = (0.0, 0.0);
         for c in 0..Grid::combinations() {
             let (reaction_s, _, _) = combination(c);
             for (cue, first, thresholds) in &self.grid.cues {
                 let start = c * nt + first;
-                let cue_mass: f64 = (self.log_posterior[start..start + thresholds.len()].iter())
-                    .map(|&lp| weight(lp, top))
-                    .sum();
+                let cue_mass: f64 = self.weights[start..start + thresholds.len()].iter().sum();
                 total += cue_mass;
                 if holds(*cue, reaction_s) {
                     mass += cue_mass;
@@ -559,9 +567,7 @@ impl DriverEstimate {
             }
         }
         // The two-cue decisions, without reaction.
-        let paired: f64 = (self.log_posterior[self.grid.single()..].iter())
-            .map(|&lp| weight(lp, top))
-            .sum();
+        let paired: f64 = self.weights[self.grid.single()..].iter().sum();
         total += paired;
         if holds(Cue::HeadwayOrTtc, 0.0) {
             mass += paired;
@@ -604,24 +610,16 @@ impl DriverEstimate {
         duration_s: f64,
     ) -> Vec<f64> {
         let view = SceneView::new(situations, dt, set_speed_mps, safe, duration_s);
-        let top = self.top();
         let mut masses = vec![0.0; situations.len() + 1];
         self.grid.for_each_start(&view, |hypotheses, start| {
             let at = (start as usize).min(situations.len());
-            masses[at] += (self.log_posterior[hypotheses].iter())
-                .map(|&lp| weight(lp, top))
-                .sum::<f64>();
+            masses[at] += self.weights[hypotheses].iter().sum::<f64>();
         });
         let total: f64 = masses.iter().sum();
         if total > 0.0 {
             masses.iter_mut().for_each(|m| *m /= total);
         }
         masses
-    }
-
-    /// The largest log posterior.
-    fn top(&self) -> f64 {
-        (self.log_posterior.iter().copied()).fold(f64::NEG_INFINITY, f64::max)
     }
 }
 
@@ -783,7 +781,7 @@ mod tests {
                 .collect();
             if let Some(estimate) = DriverEstimate::from_onsets(&onsets, 2.0) {
                 proptest::prop_assert!(!estimate.outside_model());
-                let log_likelihood = estimate.log_posterior[h] - prior(&grid)[h];
+                let log_likelihood = estimate.posterior.log_posterior[h] - prior(&grid)[h];
                 proptest::prop_assert!(
                     log_likelihood.abs() < 1e-9,
                     "{:?}: log likelihood {}", model, log_likelihood
@@ -816,9 +814,9 @@ mod tests {
         let extended = DriverEstimate::from_onsets(&onsets, 2.0).unwrap();
         for (estimate, onsets) in [(kept, &onsets[..2]), (extended, &onsets[..])] {
             let fresh = afresh(onsets);
-            assert_eq!(estimate.scenes, fresh.scenes);
+            assert_eq!(estimate.scenes(), fresh.scenes);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-            assert!(bits(&estimate.log_posterior) == bits(&fresh.log_posterior));
+            assert!(bits(&estimate.posterior.log_posterior) == bits(&fresh.log_posterior));
             let closest = fresh.worst.iter().copied().fold(f64::INFINITY, f64::min);
             assert_eq!(estimate.closest_s.to_bits(), closest.to_bits());
         }
@@ -1014,7 +1012,7 @@ mod tests {
                 && said.contains("or the time to collision at"),
             "{said}"
         );
-        let log_likelihood = estimate.log_posterior[h] - prior(&grid)[h];
+        let log_likelihood = estimate.posterior.log_posterior[h] - prior(&grid)[h];
         assert!(log_likelihood.abs() < 1e-9, "{log_likelihood}");
     }
 
