@@ -351,11 +351,20 @@ impl Accumulated {
             duration_s,
         );
         let misfit = Misfit::new(seen.len(), scene.dt, onset.time_s);
-        let (worst, log_posterior) = (&mut self.worst, &mut self.log_posterior);
+        let (worst, far_scenes, log_posterior) = (
+            &mut self.worst,
+            &mut self.far_scenes,
+            &mut self.log_posterior,
+        );
         grid.for_each_start(&view, |hypotheses, start| {
             let (error, penalty) = misfit.of(start);
             for far in &mut worst[hypotheses.clone()] {
                 *far = far.max(error);
+            }
+            if error > MISFIT_SDS * OBSERVATION_SD_S {
+                for count in &mut far_scenes[hypotheses.clone()] {
+                    *count = count.saturating_add(1);
+                }
             }
             for lp in &mut log_posterior[hypotheses] {
                 *lp -= penalty;
@@ -388,6 +397,9 @@ pub struct DriverEstimate {
     /// The smallest, over hypotheses, of the largest distance (s) between a
     /// scene's observed start and the hypothesis's.
     closest_s: f64,
+    /// The fewest, over hypotheses, of the scenes whose observed start lies
+    /// more than [`MISFIT_SDS`] standard deviations from the hypothesis's.
+    fewest_far: u16,
 }
 
 impl DriverEstimate {
@@ -412,6 +424,7 @@ impl DriverEstimate {
                         Accumulated {
                             log_posterior: prior(&grid),
                             worst: vec![0.0f64; grid.len()],
+                            far_scenes: vec![0; grid.len()],
                             scenes: 0,
                         },
                         0,
@@ -426,6 +439,7 @@ impl DriverEstimate {
             }
         };
         let closest_s = (posterior.worst.iter().copied()).fold(f64::INFINITY, f64::min);
+        let fewest_far = (posterior.far_scenes.iter().copied()).min().unwrap_or(0);
         let top = (posterior.log_posterior.iter().copied()).fold(f64::NEG_INFINITY, f64::max);
         let weights = (posterior.log_posterior.iter())
             .map(|&lp| weight(lp, top))
@@ -435,14 +449,16 @@ impl DriverEstimate {
             posterior,
             weights,
             closest_s,
+            fewest_far,
         })
     }
 
-    /// Whether no start model predicts every observed start within
-    /// [`MISFIT_SDS`] standard deviations.
+    /// Whether every start model needs more of the observed starts misread
+    /// (more than [`MISFIT_SDS`] standard deviations from its own) than the
+    /// likelihood's misread probability makes plausible for the scenes seen
+    /// ([`plausible_misreads`]): the observations contradict every hypothesis.
     pub fn outside_model(&self) -> bool {
-        // `closest_s` is infinite, never NaN, when no model starts in a scene.
-        self.closest_s > MISFIT_SDS * OBSERVATION_SD_S
+        usize::from(self.fewest_far) > plausible_misreads(self.scenes())
     }
 
     /// Scenes the estimate has seen.
@@ -474,9 +490,11 @@ impl DriverEstimate {
     pub fn describe(&self) -> String {
         if self.outside_model() {
             return format!(
-                "outside the model: no start model within {:.2} s of every start \
-                 (scenes seen: {}, closest {:.2} s)",
+                "outside the model: every start model is more than {:.2} s from {} or more of the \
+                 starts, more than one in twenty misread makes plausible (scenes seen: {}, the \
+                 closest within {:.2} s of every start)",
                 MISFIT_SDS * OBSERVATION_SD_S,
+                self.fewest_far,
                 self.scenes(),
                 self.closest_s
             );
@@ -621,6 +639,29 @@ impl DriverEstimate {
         }
         masses
     }
+}
+
+/// The most scenes of `scenes` whose starts may all have been misread without
+/// contradicting the misread probability ([`MISREAD_START_PROBABILITY`]): the
+/// largest `k` such that `k` or more misread starts among `scenes` have a
+/// probability of at least 5 % (one minus the usual 95 % credibility).
+pub(crate) fn plausible_misreads(scenes: usize) -> usize {
+    let p = MISREAD_START_PROBABILITY;
+    // P(X = k) of the binomial, k from 0; the tail P(X >= k) as 1 minus the
+    // mass below k.
+    let mut below = 0.0;
+    let mut pmf = (1.0 - p).powi(scenes as i32);
+    let mut plausible = 0;
+    for k in 0..=scenes {
+        if 1.0 - below >= 1.0 - super::CREDIBLE_MASS {
+            plausible = k;
+        } else {
+            break;
+        }
+        below += pmf;
+        pmf *= (scenes - k) as f64 / (k + 1) as f64 * p / (1.0 - p);
+    }
+    plausible
 }
 
 /// The index of the largest of `masses`, the first of equals.
@@ -802,6 +843,7 @@ mod tests {
             let mut accumulated = Accumulated {
                 log_posterior: prior(&grid),
                 worst: vec![0.0; grid.len()],
+                far_scenes: vec![0; grid.len()],
                 scenes: 0,
             };
             for onset in onsets {
@@ -824,33 +866,53 @@ mod tests {
 
     #[test]
     fn a_driver_no_start_model_explains_is_outside_the_model() {
-        // A headway driver seen in two scenes is explained; the same driver
-        // said to have started at the first step of the second scene is not:
-        // no model starts there and at 1.2 s of headway in the first.
-        let setups = scenes();
-        let mut onsets: Vec<Onset> = (0..2)
-            .filter_map(|i| {
-                let model = StartModel {
-                    rule: palc_user::StartRule::TimeHeadway,
-                    time_headway_s: 1.2,
-                    reaction_s: 0.0,
-                    min_lead_gap_s: 0.0,
-                    min_lag_gap_s: 0.0,
-                };
-                observed(&model, &setups[i])
-            })
+        // A headway driver seen in the scenes of `more_scenes` is explained.
+        // One start said to be at a scene's first step, where no model starts, is
+        // one misread start: plausible. Starts at the first step in more of them
+        // than one in twenty misread makes plausible contradict every model.
+        let setups = more_scenes();
+        let model = StartModel {
+            rule: palc_user::StartRule::TimeHeadway,
+            time_headway_s: 1.2,
+            reaction_s: 0.0,
+            min_lead_gap_s: 0.0,
+            min_lag_gap_s: 0.0,
+        };
+        let mut onsets: Vec<Onset> = (setups.iter())
+            .filter_map(|setup| observed(&model, setup))
             .collect();
-        assert_eq!(onsets.len(), 2);
+        let n = onsets.len();
+        assert!(n >= 5, "the test needs five scenes, got {n}");
+        let plausible = plausible_misreads(n);
+        assert!(plausible < n);
         let consistent = DriverEstimate::from_onsets(&onsets, 2.0).unwrap();
-        assert!(!consistent.outside_model());
-        onsets[1].time_s = 0.0;
+        assert!(!consistent.outside_model(), "{}", consistent.describe());
+        for misread in 0..=plausible {
+            let estimate = DriverEstimate::from_onsets(&onsets, 2.0).unwrap();
+            assert!(
+                !estimate.outside_model(),
+                "{misread} misread: {}",
+                estimate.describe()
+            );
+            onsets[misread].time_s = 0.0;
+        }
         let contradicted = DriverEstimate::from_onsets(&onsets, 2.0).unwrap();
-        assert!(contradicted.outside_model());
-        let (seen, dt, speed) = (&setups[2].situations, setups[2].dt, setups[2].set_speed);
+        assert!(contradicted.outside_model(), "{}", contradicted.describe());
+        let (seen, dt, speed) = (&setups[0].situations, setups[0].dt, setups[0].set_speed);
         assert_eq!(
             contradicted.predict(seen, dt, speed, None, 2.0),
             Prediction::OutsideModel
         );
+    }
+
+    #[test]
+    fn the_plausible_misreads_are_the_binomials_5_percent_tail() {
+        // One in twenty misread: k or more of n have a probability of at least 5 %.
+        let expected = [(1, 1), (2, 1), (5, 1), (10, 2), (20, 3), (50, 5), (100, 9)];
+        for (scenes, plausible) in expected {
+            assert_eq!(plausible_misreads(scenes), plausible, "{scenes} scenes");
+        }
+        assert_eq!(plausible_misreads(0), 0);
     }
 
     /// The scenes of the default config among every speed case, two headways and

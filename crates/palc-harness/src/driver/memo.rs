@@ -24,6 +24,9 @@ pub(super) struct Accumulated {
     pub log_posterior: Vec<f64>,
     /// Per hypothesis, the largest distance (s) between a scene's observed start and its own.
     pub worst: Vec<f64>,
+    /// Per hypothesis, the scenes whose observed start lies more than the
+    /// misfit's distance from its own.
+    pub far_scenes: Vec<u16>,
     /// Scenes read.
     pub scenes: usize,
 }

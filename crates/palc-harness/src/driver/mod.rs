@@ -16,8 +16,11 @@
 //! in the scene with [`prior::MISREAD_START_PROBABILITY`]): a model that would have
 //! started earlier, or later, is penalized alike, so the steps at which the
 //! driver did not start count as much as its start. Scenes combine by
-//! multiplying likelihoods. When no model explains every scene to within
-//! [`prior::MISFIT_SDS`] standard deviations, the driver is outside the model.
+//! multiplying likelihoods. A scene whose observed start is more than
+//! [`prior::MISFIT_SDS`] standard deviations from a model's is one that model
+//! needs misread; when every model needs more misread starts than one in twenty
+//! makes plausible (at 5 %, binomially: 1 of up to 5 scenes, 2 of 10, 5 of 50),
+//! the driver is outside the model.
 //!
 //! Every [`crate::LessonEvent`] hands its observers the evidence with that
 //! lesson's start included ([`crate::DriverEvidence`]); the estimate is computed

@@ -25,9 +25,10 @@ pub const OBSERVATION_SD_S: f64 = 0.2;
 /// misread start outweighs every other scene: a ttc-start user's estimate moved
 /// to a 0.7 s reaction and predicted 0.4 s late (0081).
 pub const MISREAD_START_PROBABILITY: f64 = 0.05;
-/// A driver is outside the model when no model of the grid predicts every
-/// observed start within this many [`OBSERVATION_SD_S`] (0.6 s): a start that far
-/// from every model's is not observation noise.
+/// A start this many [`OBSERVATION_SD_S`] (0.6 s) from a model's is not
+/// observation noise: the model needs it misread. A driver is outside the
+/// model when every model of the grid needs more misread starts than
+/// [`MISREAD_START_PROBABILITY`] makes plausible (0087).
 pub const MISFIT_SDS: f64 = 3.0;
 /// Time-headway thresholds (s): from 0.3 s, closer than drivers keep while
 /// still deciding, to 4 s, beyond the 2.2 s at which the scenes' plans start;
