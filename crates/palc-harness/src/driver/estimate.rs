@@ -456,7 +456,7 @@ impl DriverEstimate {
     /// Whether every start model needs more of the observed starts misread
     /// (more than [`MISFIT_SDS`] standard deviations from its own) than the
     /// likelihood's misread probability makes plausible for the scenes seen
-    /// ([`plausible_misreads`]): the observations contradict every hypothesis.
+    /// (`plausible_misreads`): the observations contradict every hypothesis.
     pub fn outside_model(&self) -> bool {
         usize::from(self.fewest_far) > plausible_misreads(self.scenes())
     }
