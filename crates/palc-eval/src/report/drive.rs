@@ -4,10 +4,10 @@
 
 use std::fmt::{self, Write as _};
 
-use super::section::{Out, Results, Section, fill, header};
+use super::section::{Out, Results, Section, fill, header, state_targets};
 use crate::drive_report::{BANDS, WINDOW, table_lines};
 use crate::plan::Experiment;
-use crate::targets::{TargetId, Verdict, target};
+use crate::targets::TargetId;
 
 /// The drive section.
 pub struct Drive;
@@ -39,17 +39,8 @@ impl Section for Drive {
             writeln!(out, "{line}")?;
         }
         writeln!(out)?;
-        for id in [TargetId::DriveOwnFamilies, TargetId::DriveOutOfClass] {
-            let target = target(id);
-            for &method in results.methods() {
-                let cases = target.cases(&results.index, method, results.input.user_kinds);
-                if target.judge(&cases) == Verdict::NotMeasured {
-                    continue;
-                }
-                let who = format!("`{}`, each user kind", method.name());
-                writeln!(out, "- {}", target.state_cases(&who, &cases))?;
-            }
-        }
+        let ids = [TargetId::DriveOwnFamilies, TargetId::DriveOutOfClass];
+        state_targets(out, results, &ids)?;
         writeln!(out)
     }
 }

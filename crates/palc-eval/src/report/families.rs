@@ -8,9 +8,9 @@ use crate::claims::{num, pct};
 use crate::config::UserKind;
 use crate::results::RunRow;
 use crate::stats::{self, Summary};
-use crate::targets::{TargetId, Verdict, target};
+use crate::targets::TargetId;
 
-use super::section::{Out, Results, Section, fill};
+use super::section::{Out, Results, Section, fill, state_targets};
 
 /// The CSV file of the user-family table.
 pub const FILE: &str = "families.csv";
@@ -49,21 +49,12 @@ impl Section for Families {
             &[("file", FILE.to_owned())],
         );
         writeln!(out, "{text}\n")?;
-        for id in [
+        let ids = [
             TargetId::KindsLearned,
             TargetId::KindTransfer,
             TargetId::SpreadAfterLearning,
-        ] {
-            let target = target(id);
-            for &method in results.methods() {
-                let cases = target.cases(&results.index, method, kinds);
-                if target.judge(&cases) == Verdict::NotMeasured {
-                    continue;
-                }
-                let who = format!("`{}`, each user kind", method.name());
-                writeln!(out, "- {}", target.state_cases(&who, &cases))?;
-            }
-        }
+        ];
+        state_targets(out, results, &ids)?;
         writeln!(out)?;
         for kind in kinds {
             for &method in results.methods() {

@@ -13,14 +13,14 @@ use std::fmt::{self, Write as _};
 
 use palc_harness::Method;
 
-use super::section::{Results, Section, fill, header};
+use super::section::{Results, Section, fill, header, state_targets};
 use crate::claims::{num, pct};
 use crate::config::UserKind;
 use crate::drive_report::{self, KindDrives};
 use crate::plan::Experiment;
 use crate::results::RunRow;
 use crate::stats::{self, Summary};
-use crate::targets::{TargetId, Verdict, target};
+use crate::targets::TargetId;
 
 /// The drive's band the table shows (lane changes, counted from 1).
 const DRIVE_BAND: (usize, usize) = (11, 50);
@@ -125,16 +125,7 @@ impl Section for Outside {
             TargetId::OutOfClassTransfer,
             TargetId::OutOfClassAccumulation,
         ];
-        for target in ids.map(target) {
-            for &method in results.methods() {
-                let cases = target.cases(&results.index, method, results.input.user_kinds);
-                if target.judge(&cases) == Verdict::NotMeasured {
-                    continue;
-                }
-                let who = format!("`{}`, each user kind", method.name());
-                writeln!(out, "- {}", target.state_cases(&who, &cases))?;
-            }
-        }
+        state_targets(out, results, &ids)?;
         writeln!(out)
     }
 }

@@ -9,6 +9,7 @@ use palc_harness::Method;
 use crate::config::UserKind;
 use crate::harness_runs::ExampleTrace;
 use crate::manifest::Manifest;
+use crate::targets::{TargetId, Verdict, target};
 use crate::views::{FigureFile, Indexed};
 
 /// Everything the report is made of.
@@ -132,6 +133,24 @@ pub fn fill(template: &str, values: &[(&str, String)]) -> String {
         text = text.replace(&format!("{{{name}}}"), value);
     }
     text
+}
+
+/// Each target of `ids` stated once per method, over every user kind, as
+/// bullet lines (`Target::state_cases`); a target with nothing measured for a
+/// method is left out.
+pub fn state_targets(out: &mut Out, results: &Results, ids: &[TargetId]) -> fmt::Result {
+    use fmt::Write as _;
+    for target in ids.iter().map(|&id| target(id)) {
+        for &method in results.methods() {
+            let cases = target.cases(&results.index, method, results.input.user_kinds);
+            if target.judge(&cases) == Verdict::NotMeasured {
+                continue;
+            }
+            let who = format!("`{}`, each user kind", method.name());
+            writeln!(out, "- {}", target.state_cases(&who, &cases))?;
+        }
+    }
+    Ok(())
 }
 
 /// A markdown table's header line and separator.
