@@ -568,6 +568,17 @@ mod tests {
         })
     }
 
+    /// A transfer with no pair to measure.
+    fn no_pairs() -> Measured {
+        Measured::Transfer(Pairs {
+            pairs: 0,
+            without: None,
+            with: None,
+            worse: 0,
+            capped: 0,
+        })
+    }
+
     #[test]
     fn every_target_has_one_entry_and_nothing_measured_is_not_measured() {
         for (i, t) in TARGETS.iter().enumerate() {
@@ -592,14 +603,7 @@ mod tests {
         let headway = target(TargetId::TransferHeadway);
         assert_eq!(headway.verdict(&pairs(3.0, 1.0, 0, 0)), Verdict::NotMet);
         assert!(headway.rule.describe().starts_with("at least 80 % fewer"));
-        let none = Measured::Transfer(Pairs {
-            pairs: 0,
-            without: None,
-            with: None,
-            worse: 0,
-            capped: 0,
-        });
-        assert_eq!(t.verdict(&none), Verdict::NotMeasured);
+        assert_eq!(t.verdict(&no_pairs()), Verdict::NotMeasured);
     }
 
     #[test]
@@ -608,14 +612,7 @@ mod tests {
         // No gain, even a loss, is met while no pair is worse by more than one.
         assert_eq!(t.verdict(&pairs(1.0, 1.4, 0, 2)), Verdict::Met);
         assert_eq!(t.verdict(&pairs(1.0, 0.2, 1, 0)), Verdict::NotMet);
-        let none = Measured::Transfer(Pairs {
-            pairs: 0,
-            without: None,
-            with: None,
-            worse: 0,
-            capped: 0,
-        });
-        assert_eq!(t.verdict(&none), Verdict::NotMeasured);
+        assert_eq!(t.verdict(&no_pairs()), Verdict::NotMeasured);
     }
 
     #[test]
