@@ -275,3 +275,46 @@ fn the_replans_follow_the_speeds_they_are_given() {
         terminal.v
     );
 }
+
+/// A lane change after a lesson that could not be learned drives the same plan
+/// with the same experience; the learning loop hands back the drive before it
+/// instead of re-planning again, and what it hands back is the drive computed
+/// afresh.
+#[test]
+fn a_closed_loop_drive_repeated_after_a_failed_lesson_is_the_one_driven_afresh() {
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../../configs/learn.toml"
+    ))
+    .unwrap();
+    let mut config = LearnConfig::from_toml_str(&text).unwrap();
+    config.method = palc_harness::Method::Paper;
+    config.planning.closed_loop.enabled = true;
+    config.planning.closed_loop.replan_period_s = 0.5;
+    config.stopping.max_takeovers = 4;
+    let options = palc_harness::advanced::aggregator_options(&config);
+    let mut run = palc_harness::LearningLoop::new(&config, None).unwrap();
+    let setup = run.setup().clone();
+    let planner = PlannerConfig {
+        horizon: setup.horizon,
+        dt: setup.dt,
+        lateral_bounds_mode: palc_planner::LateralBoundsMode::Hard,
+        ..config.planner.clone()
+    };
+    let period = config.planning.closed_loop.period_steps(setup.dt);
+    let driver = ClosedLoop::new(planner, period, None).unwrap();
+    let mut repeats = 0;
+    let mut failed_before = false;
+    for _ in 0..4 {
+        let (afresh, stats) = driver
+            .drive(&setup, run.experience(), &options, run.next_plan(), false)
+            .unwrap();
+        let record = run.step(&mut palc_harness::NoObserver).unwrap();
+        assert_eq!(record.closed_loop, Some(stats));
+        let planned: Vec<f64> = afresh.states.iter().map(|x| x.l).collect();
+        assert_eq!(record.planned_l, planned);
+        repeats += usize::from(failed_before);
+        failed_before = record.learning_error.is_some();
+    }
+    assert!(repeats > 0, "the paper's lessons are expected to fail here");
+}

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use palc_aggregator::Onset;
 use palc_user::{Situation, StartModel};
 
-use super::memo::{self, Accumulated};
+use super::memo::{self, Accumulated, Posterior};
 use super::prior::{
     self, Cue, LAG_GAPS_S, LEAD_GAPS_S, MISFIT_SDS, MISREAD_START_PROBABILITY, OBSERVATION_SD_S,
     REACTIONS_S,
@@ -389,17 +389,9 @@ pub enum Prediction {
 #[derive(Debug, Clone)]
 pub struct DriverEstimate {
     grid: Grid,
-    /// The posterior as accumulated over the scenes (shared with the memo).
-    posterior: Arc<Accumulated>,
-    /// The posterior weight of each hypothesis, the largest 1: every mass the
-    /// estimate reports is a sum of these, computed once per estimate.
-    weights: Vec<f64>,
-    /// The smallest, over hypotheses, of the largest distance (s) between a
-    /// scene's observed start and the hypothesis's.
-    closest_s: f64,
-    /// The fewest, over hypotheses, of the scenes whose observed start lies
-    /// more than [`MISFIT_SDS`] standard deviations from the hypothesis's.
-    fewest_far: u16,
+    /// The posterior as accumulated over the scenes, with its weights (shared
+    /// with the memo).
+    posterior: Arc<Posterior>,
 }
 
 impl DriverEstimate {
@@ -419,7 +411,7 @@ impl DriverEstimate {
             Some((kept, read)) if read == seen.len() => kept,
             kept => {
                 let (mut accumulated, read) = match kept {
-                    Some((kept, read)) => (Accumulated::clone(&kept), read),
+                    Some((kept, read)) => (kept.accumulated.clone(), read),
                     None => (
                         Accumulated {
                             log_posterior: prior(&grid),
@@ -433,24 +425,12 @@ impl DriverEstimate {
                 for onset in &seen[read..] {
                     accumulated.read(&grid, onset, duration_s);
                 }
-                let accumulated = Arc::new(accumulated);
-                memo::keep(&seen, duration_s, Arc::clone(&accumulated));
-                accumulated
+                let posterior = Arc::new(summarized(accumulated));
+                memo::keep(&seen, duration_s, Arc::clone(&posterior));
+                posterior
             }
         };
-        let closest_s = (posterior.worst.iter().copied()).fold(f64::INFINITY, f64::min);
-        let fewest_far = (posterior.far_scenes.iter().copied()).min().unwrap_or(0);
-        let top = (posterior.log_posterior.iter().copied()).fold(f64::NEG_INFINITY, f64::max);
-        let weights = (posterior.log_posterior.iter())
-            .map(|&lp| weight(lp, top))
-            .collect();
-        Some(DriverEstimate {
-            grid,
-            posterior,
-            weights,
-            closest_s,
-            fewest_far,
-        })
+        Some(DriverEstimate { grid, posterior })
     }
 
     /// Whether every start model needs more of the observed starts misread
@@ -458,12 +438,12 @@ impl DriverEstimate {
     /// likelihood's misread probability makes plausible for the scenes seen
     /// (`plausible_misreads`): the observations contradict every hypothesis.
     pub fn outside_model(&self) -> bool {
-        usize::from(self.fewest_far) > plausible_misreads(self.scenes())
+        usize::from(self.posterior.fewest_far) > plausible_misreads(self.scenes())
     }
 
     /// Scenes the estimate has seen.
     pub fn scenes(&self) -> usize {
-        self.posterior.scenes
+        self.posterior.accumulated.scenes
     }
 
     /// The posterior's most probable start model: among equals, the first of
@@ -475,7 +455,7 @@ impl DriverEstimate {
     }
 
     fn most_probable_index(&self) -> usize {
-        let (h, _) = (self.posterior.log_posterior.iter().enumerate()).fold(
+        let (h, _) = (self.posterior.accumulated.log_posterior.iter().enumerate()).fold(
             (0, f64::NEG_INFINITY),
             |best, (h, &lp)| {
                 if lp > best.1 + 1e-12 { (h, lp) } else { best }
@@ -494,9 +474,9 @@ impl DriverEstimate {
                  starts, more than one in twenty misread makes plausible (scenes seen: {}, the \
                  closest within {:.2} s of every start)",
                 MISFIT_SDS * OBSERVATION_SD_S,
-                self.fewest_far,
+                self.posterior.fewest_far,
                 self.scenes(),
-                self.closest_s
+                self.posterior.closest_s
             );
         }
         let h = self.most_probable_index();
@@ -552,14 +532,14 @@ impl DriverEstimate {
         for c in 0..Grid::combinations() {
             for ((_, first, thresholds), mass) in self.grid.cues.iter().zip(&mut masses) {
                 let start = c * nt + first;
-                for &weight in &self.weights[start..start + thresholds.len()] {
+                for &weight in &self.posterior.weights[start..start + thresholds.len()] {
                     total += weight;
                     *mass += weight;
                 }
             }
         }
         let mut paired = -0.0;
-        for &weight in &self.weights[self.grid.single()..] {
+        for &weight in &self.posterior.weights[self.grid.single()..] {
             total += weight;
             paired += weight;
         }
@@ -577,7 +557,9 @@ impl DriverEstimate {
             let (reaction_s, _, _) = combination(c);
             for (cue, first, thresholds) in &self.grid.cues {
                 let start = c * nt + first;
-                let cue_mass: f64 = self.weights[start..start + thresholds.len()].iter().sum();
+                let cue_mass: f64 = self.posterior.weights[start..start + thresholds.len()]
+                    .iter()
+                    .sum();
                 total += cue_mass;
                 if holds(*cue, reaction_s) {
                     mass += cue_mass;
@@ -585,7 +567,7 @@ impl DriverEstimate {
             }
         }
         // The two-cue decisions, without reaction.
-        let paired: f64 = self.weights[self.grid.single()..].iter().sum();
+        let paired: f64 = self.posterior.weights[self.grid.single()..].iter().sum();
         total += paired;
         if holds(Cue::HeadwayOrTtc, 0.0) {
             mass += paired;
@@ -631,7 +613,7 @@ impl DriverEstimate {
         let mut masses = vec![0.0; situations.len() + 1];
         self.grid.for_each_start(&view, |hypotheses, start| {
             let at = (start as usize).min(situations.len());
-            masses[at] += self.weights[hypotheses].iter().sum::<f64>();
+            masses[at] += self.posterior.weights[hypotheses].iter().sum::<f64>();
         });
         let total: f64 = masses.iter().sum();
         if total > 0.0 {
@@ -675,6 +657,23 @@ pub(crate) fn most_likely_step(masses: &[f64]) -> usize {
 /// The posterior weight of a hypothesis of log posterior `lp`, scaled so that
 /// the largest (`top`) is 1.
 #[inline]
+/// `accumulated` with its weights, its closest and its fewest far scenes
+/// (`MISFIT_SDS` standard deviations away).
+fn summarized(accumulated: Accumulated) -> Posterior {
+    let closest_s = (accumulated.worst.iter().copied()).fold(f64::INFINITY, f64::min);
+    let fewest_far = (accumulated.far_scenes.iter().copied()).min().unwrap_or(0);
+    let top = (accumulated.log_posterior.iter().copied()).fold(f64::NEG_INFINITY, f64::max);
+    let weights = (accumulated.log_posterior.iter())
+        .map(|&lp| weight(lp, top))
+        .collect();
+    Posterior {
+        accumulated,
+        weights,
+        closest_s,
+        fewest_far,
+    }
+}
+
 fn weight(lp: f64, top: f64) -> f64 {
     let below_top = lp - top;
     // `exp` is exactly +0 below its underflow (about -745.13): the many
@@ -822,7 +821,7 @@ mod tests {
                 .collect();
             if let Some(estimate) = DriverEstimate::from_onsets(&onsets, 2.0) {
                 proptest::prop_assert!(!estimate.outside_model());
-                let log_likelihood = estimate.posterior.log_posterior[h] - prior(&grid)[h];
+                let log_likelihood = estimate.posterior.accumulated.log_posterior[h] - prior(&grid)[h];
                 proptest::prop_assert!(
                     log_likelihood.abs() < 1e-9,
                     "{:?}: log likelihood {}", model, log_likelihood
@@ -858,9 +857,11 @@ mod tests {
             let fresh = afresh(onsets);
             assert_eq!(estimate.scenes(), fresh.scenes);
             let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
-            assert!(bits(&estimate.posterior.log_posterior) == bits(&fresh.log_posterior));
+            assert!(
+                bits(&estimate.posterior.accumulated.log_posterior) == bits(&fresh.log_posterior)
+            );
             let closest = fresh.worst.iter().copied().fold(f64::INFINITY, f64::min);
-            assert_eq!(estimate.closest_s.to_bits(), closest.to_bits());
+            assert_eq!(estimate.posterior.closest_s.to_bits(), closest.to_bits());
         }
     }
 
@@ -1074,7 +1075,7 @@ mod tests {
                 && said.contains("or the time to collision at"),
             "{said}"
         );
-        let log_likelihood = estimate.posterior.log_posterior[h] - prior(&grid)[h];
+        let log_likelihood = estimate.posterior.accumulated.log_posterior[h] - prior(&grid)[h];
         assert!(log_likelihood.abs() < 1e-9, "{log_likelihood}");
     }
 

@@ -8,7 +8,7 @@
 //! posterior is a sum over scenes in their order, so an extended one is bit for
 //! bit the one recomputed (a test checks it).
 //!
-//! The memo holds [`capacity`] posteriors (25 MB each), the most recently used
+//! The memo holds [`capacity`] posteriors (40 MB each, with their weights), the most recently used
 //! last; an entry serves an estimate whose scenes begin with the entry's, and,
 //! when a scene carries the safety layer's verdicts (which depend on the lane
 //! change's duration), whose duration is the entry's.
@@ -31,13 +31,29 @@ pub(super) struct Accumulated {
     pub scenes: usize,
 }
 
+/// A posterior with what every estimate from it reads: computed once, when
+/// the posterior is, and shared by every estimate that finds it kept.
+#[derive(Debug)]
+pub(super) struct Posterior {
+    pub accumulated: Accumulated,
+    /// The posterior weight of each hypothesis, the largest 1: every mass an
+    /// estimate reports is a sum of these.
+    pub weights: Vec<f64>,
+    /// The smallest, over hypotheses, of the largest distance (s) between a
+    /// scene's observed start and the hypothesis's.
+    pub closest_s: f64,
+    /// The fewest, over hypotheses, of the scenes whose observed start lies
+    /// far from the hypothesis's.
+    pub fewest_far: u16,
+}
+
 /// One posterior and what it was computed from.
 struct Entry {
     /// The onsets read, in order.
     onsets: Vec<Onset>,
     /// The lane change's duration, when a scene's safety verdicts made it matter.
     duration_bits: Option<u64>,
-    accumulated: Arc<Accumulated>,
+    posterior: Arc<Posterior>,
 }
 
 /// Posteriors kept: two per core, so that every thread of an evaluation (one
@@ -67,7 +83,7 @@ fn duration_matters(onsets: &[&Onset]) -> bool {
 pub(super) fn longest_beginning(
     onsets: &[&Onset],
     duration_s: f64,
-) -> Option<(Arc<Accumulated>, usize)> {
+) -> Option<(Arc<Posterior>, usize)> {
     let entries = memo().lock().unwrap_or_else(PoisonError::into_inner);
     (entries.iter().rev())
         .filter(|e| e.onsets.len() <= onsets.len())
@@ -77,16 +93,16 @@ pub(super) fn longest_beginning(
         })
         .filter(|e| e.onsets.iter().zip(onsets).all(|(a, b)| a == *b))
         .max_by_key(|e| e.onsets.len())
-        .map(|e| (Arc::clone(&e.accumulated), e.onsets.len()))
+        .map(|e| (Arc::clone(&e.posterior), e.onsets.len()))
 }
 
 /// Keeps the posterior of `onsets` (all with their scene) and a lane change of
 /// `duration_s`, dropping the least recently kept beyond [`capacity`].
-pub(super) fn keep(onsets: &[&Onset], duration_s: f64, accumulated: Arc<Accumulated>) {
+pub(super) fn keep(onsets: &[&Onset], duration_s: f64, posterior: Arc<Posterior>) {
     let entry = Entry {
         onsets: onsets.iter().map(|&o| o.clone()).collect(),
         duration_bits: duration_matters(onsets).then(|| duration_s.to_bits()),
-        accumulated,
+        posterior,
     };
     let mut entries = memo().lock().unwrap_or_else(PoisonError::into_inner);
     entries.retain(|e| e.onsets != entry.onsets || e.duration_bits != entry.duration_bits);

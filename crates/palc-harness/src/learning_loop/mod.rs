@@ -14,6 +14,7 @@
 
 mod checks;
 mod live;
+mod repeat;
 mod run_state;
 
 use std::time::Instant;
@@ -35,13 +36,14 @@ use crate::lesson::{lesson, scenes, zone_feature_set};
 use crate::method::Method;
 use crate::observer::{DriverEvidence, LessonEvent, Observer};
 use crate::personalization::{self, LessonPaths, Personalization};
-use crate::record::{FrozenEvaluation, LaneChangeRecord, Outcome, RunResult};
+use crate::record::{ClosedLoopStats, FrozenEvaluation, LaneChangeRecord, Outcome, RunResult};
 use crate::refusal::Refusal;
 use crate::safety::{SafetyMetrics, Violation};
 use crate::scenario::{aggregator_options, prepare_for};
 use crate::setup::Setup;
 use crate::world::World;
 
+use repeat::{LastDrive, LastFailure};
 use run_state::{RunState, termination};
 
 /// One run of the lesson-learning loop (paper Fig. 2): plan with the experience,
@@ -97,6 +99,8 @@ struct Scenario {
     fallback: Option<(Plan, SafetyMetrics)>,
     /// With `[planning.closed_loop]` on, the closed-loop driver.
     closed_loop: Option<ClosedLoop>,
+    /// The last closed-loop drive in palc's own traffic, repeated from equal inputs.
+    last_closed_loop: LastDrive,
     /// The simulator the lane changes are driven in, when not palc's own traffic.
     world: Option<Box<dyn World>>,
 }
@@ -112,6 +116,8 @@ struct Learner {
     pending_times: Timings,
     /// What the driver estimate believed when the experience was carried in.
     carried_belief: Option<CarriedBelief>,
+    /// The last lesson that could not be learned, repeated from equal inputs.
+    last_failure: LastFailure,
 }
 
 impl LearningLoop {
@@ -233,6 +239,7 @@ impl LearningLoop {
                 template,
                 fallback,
                 closed_loop,
+                last_closed_loop: LastDrive::default(),
                 world: None,
             },
             learner: Learner {
@@ -242,6 +249,7 @@ impl LearningLoop {
                 next_plan,
                 pending_times,
                 carried_belief,
+                last_failure: LastFailure::default(),
             },
             run: RunState::default(),
         })
@@ -385,21 +393,8 @@ impl LearningLoop {
         observer: &mut dyn Observer,
     ) -> Result<(Drive, LaneChangeRecord), HarnessError> {
         let (plan, planned_safety, refusal) = self.checked_plan()?;
-        let (plan, closed_loop) = match &self.scenario.closed_loop {
-            Some(driver) => {
-                let (plan, stats) = driver.drive_in(
-                    &self.scenario.setup,
-                    &self.learner.experience,
-                    &self.policy.options,
-                    &plan,
-                    refusal.is_some(),
-                    self.scenario
-                        .world
-                        .as_deref_mut()
-                        .map(|w| w as &mut dyn World),
-                )?;
-                (plan, Some(stats))
-            }
+        let (plan, closed_loop) = match self.drive_closed_loop(&plan, refusal.is_some())? {
+            Some((plan, stats)) => (plan, Some(stats)),
             None => (plan, None),
         };
         let refusal = refusal.or(closed_loop.and_then(|c| c.first_refusal));
@@ -413,6 +408,39 @@ impl LearningLoop {
         record.safety_refusal = refusal;
         record.closed_loop = closed_loop;
         Ok((drive, record))
+    }
+
+    /// With `[planning.closed_loop]` on, `first` driven in closed loop (the
+    /// drive before it handed back when its inputs are the same, [`LastDrive`]).
+    fn drive_closed_loop(
+        &mut self,
+        first: &Plan,
+        fell_back: bool,
+    ) -> Result<Option<(Plan, ClosedLoopStats)>, HarnessError> {
+        let scenario = &mut self.scenario;
+        let Some(driver) = &scenario.closed_loop else {
+            return Ok(None);
+        };
+        let (experience, options) = (&self.learner.experience, &self.policy.options);
+        if let Some(world) = scenario.world.as_deref_mut() {
+            let driven = driver.drive_in(
+                &scenario.setup,
+                experience,
+                options,
+                first,
+                fell_back,
+                Some(world),
+            )?;
+            return Ok(Some(driven));
+        }
+        let last = &mut scenario.last_closed_loop;
+        if let Some(driven) = last.get(experience, options, first, fell_back) {
+            return Ok(Some(driven));
+        }
+        let driven =
+            driver.drive_in(&scenario.setup, experience, options, first, fell_back, None)?;
+        last.keep(experience, options, first, fell_back, &driven);
+        Ok(Some(driven))
     }
 
     /// The evaluation phase of a user with spread (`loop.frozen_lane_changes`):
@@ -509,6 +537,7 @@ impl LearningLoop {
             }
         }
         if let Some(driver) = &mut self.scenario.closed_loop {
+            self.scenario.last_closed_loop.forget();
             driver.plan_at_speeds(&template.reference_speed, template.terminal)?;
         }
         Ok(())
@@ -576,13 +605,26 @@ impl LearningLoop {
             self.follow_user_speed(drive, takeover_step)?;
         }
         let (setup, learner) = (&self.scenario.setup, &mut self.learner);
-        let result: Result<StepOutcome, AggregatorError> = learn_from_lesson(
-            &mut learner.planner,
-            &learner.experience,
-            &lesson,
-            &self.scenario.template,
-            &self.policy.options,
-        );
+        let (template, options) = (&self.scenario.template, &self.policy.options);
+        let experience = &learner.experience;
+        let result: Result<StepOutcome, &AggregatorError> = match learner
+            .last_failure
+            .get(experience, &lesson, template, options)
+        {
+            Some(error) => Err(error),
+            None => match learn_from_lesson(
+                &mut learner.planner,
+                experience,
+                &lesson,
+                template,
+                options,
+            ) {
+                Ok(outcome) => Ok(outcome),
+                Err(error) => Err(learner
+                    .last_failure
+                    .keep(experience, &lesson, template, options, error)),
+            },
+        };
         let lane_change_duration_s = setup.standard_alc.lane_change_duration_s;
         match result {
             Ok(mut outcome) => {
@@ -610,7 +652,7 @@ impl LearningLoop {
                 observer.lesson(&LessonEvent::Failed {
                     lane_change,
                     lesson: &lesson,
-                    error: &error,
+                    error,
                     driver: DriverEvidence {
                         onsets: &learner.experience.onsets,
                         lane_change_duration_s,
