@@ -21,6 +21,7 @@
 //!    the lane changes that start in that lanelet (the offset is constant along the
 //!    corridor, so the start and end found in step 3 do not depend on it).
 
+use super::error::ImportError;
 use super::geometry::Projection;
 use super::map::Map;
 use super::params::{
@@ -88,13 +89,18 @@ pub(crate) fn lateral_speed(y: &[f64], dt: f64, half: usize) -> Vec<f64> {
 }
 
 /// The lane changes of a scenario, with the counts of what was skipped.
+///
+/// # Errors
+/// [`ImportError::InvalidLanelet`] when two lanelets a vehicle changes between
+/// have centres (the map's, or the traffic's on them) that are not a positive
+/// lane width apart on the side of the lane change (`file` names the source).
 pub(crate) fn lane_changes(
     map: &Map,
     tracks: &[Track],
     dt: f64,
-    scenario: &str,
+    (file, scenario): (&str, &str),
     counts: &mut Counts,
-) -> Vec<RecordedLaneChange> {
+) -> Result<Vec<RecordedLaneChange>, ImportError> {
     let half = (LATERAL_SPEED_HALF_WINDOW_S / dt).round().max(1.0) as usize;
     let exclusion = (CENTRE_EXCLUSION_S / dt).round() as usize;
     let located: Vec<Vec<Option<usize>>> = tracks
@@ -176,7 +182,7 @@ pub(crate) fn lane_changes(
     let offsets = traffic_centres(map, tracks, &located, &excluded, counts);
     candidates
         .iter()
-        .map(|c| describe(map, tracks, &offsets, c, dt, half, scenario, counts))
+        .map(|c| describe(map, tracks, &offsets, c, dt, half, (file, scenario), counts))
         .collect()
 }
 
@@ -226,9 +232,9 @@ fn describe(
     c: &Candidate,
     dt: f64,
     half: usize,
-    scenario: &str,
+    (file, scenario): (&str, &str),
     counts: &mut Counts,
-) -> RecordedLaneChange {
+) -> Result<RecordedLaneChange, ImportError> {
     let track = &tracks[c.track];
     let n = track.len();
     let sg = sign(c.direction);
@@ -247,6 +253,19 @@ fn describe(
         .fold(f64::NEG_INFINITY, f64::max);
     let p = track.position[c.crossing];
     let width = y[c.crossing] - sg * (map.corridor(c.to).project(p).d - offset_to);
+    if !(width.is_finite() && width > 0.0) {
+        return Err(ImportError::InvalidLanelet {
+            source_name: file.to_owned(),
+            id: map.lanelets[c.to].id,
+            reason: format!(
+                "vehicle {} changes into it from lanelet {} at step {}, where the two centres lie {width:?} m apart \
+                 on the side of the lane change (must be positive and finite): the lanelets overlap or lie in the wrong order",
+                track.id,
+                map.lanelets[c.from].id,
+                track.first_step + c.crossing as i64,
+            ),
+        });
+    }
     let end_on_target = map.corridor(c.to).project(map.corridor_end(c.from)).s;
     let merge = map.corridor(c.to).length() - end_on_target > MERGE_MARGIN_M;
     if merge {
@@ -310,7 +329,7 @@ fn describe(
             }
         }
     }
-    RecordedLaneChange {
+    Ok(RecordedLaneChange {
         scenario: scenario.to_owned(),
         vehicle_id: track.id,
         vehicle_type: track.kind.clone(),
@@ -336,5 +355,5 @@ fn describe(
             CentreSource::Map
         },
         trace,
-    }
+    })
 }

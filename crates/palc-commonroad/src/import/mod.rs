@@ -104,7 +104,8 @@ pub fn import_str(text: &str, file: &str) -> Result<ScenarioImport, ImportError>
             }
         }
     }
-    let lane_changes = detect::lane_changes(&map, &kept, dt, &root.benchmark_id, &mut counts);
+    let lane_changes =
+        detect::lane_changes(&map, &kept, dt, (file, &root.benchmark_id), &mut counts)?;
     Ok(ScenarioImport {
         source: Source {
             file: file.to_owned(),
