@@ -199,8 +199,8 @@ fn closed_loop_stats_round_trip_through_json() {
     assert_eq!(back, stats);
 }
 
-#[test]
-fn a_closed_loop_run_records_its_replans_and_round_trips() {
+/// The base learning config with the closed loop on, re-planning every 0.5 s.
+fn closed_loop_config() -> LearnConfig {
     let text = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../../configs/learn.toml"
@@ -209,6 +209,12 @@ fn a_closed_loop_run_records_its_replans_and_round_trips() {
     let mut config = LearnConfig::from_toml_str(&text).unwrap();
     config.planning.closed_loop.enabled = true;
     config.planning.closed_loop.replan_period_s = 0.5;
+    config
+}
+
+#[test]
+fn a_closed_loop_run_records_its_replans_and_round_trips() {
+    let mut config = closed_loop_config();
     config.stopping.max_takeovers = 2;
     let mut run = palc_harness::LearningLoop::new(&config, None).unwrap();
     let record = run.step(&mut palc_harness::NoObserver).unwrap().clone();
@@ -282,15 +288,8 @@ fn the_replans_follow_the_speeds_they_are_given() {
 /// afresh.
 #[test]
 fn a_closed_loop_drive_repeated_after_a_failed_lesson_is_the_one_driven_afresh() {
-    let text = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/../../configs/learn.toml"
-    ))
-    .unwrap();
-    let mut config = LearnConfig::from_toml_str(&text).unwrap();
+    let mut config = closed_loop_config();
     config.method = palc_harness::Method::Paper;
-    config.planning.closed_loop.enabled = true;
-    config.planning.closed_loop.replan_period_s = 0.5;
     config.stopping.max_takeovers = 4;
     let options = palc_harness::advanced::aggregator_options(&config);
     let mut run = palc_harness::LearningLoop::new(&config, None).unwrap();
