@@ -27,19 +27,20 @@ pub(crate) fn scene_steps(setup: &Setup) -> SceneSteps {
 
 /// The situations of recorded steps, as the driver saw them.
 pub(crate) fn situations(scene: &SceneSteps) -> Vec<Situation> {
-    (scene.steps.iter())
-        .map(|step| {
-            let gap = step.preceding.map_or(f64::INFINITY, |(gap, _)| gap);
-            Situation {
-                time_headway_s: gap / step.ego_speed,
-                preceding_gap_m: gap,
-                preceding_speed: step.preceding.map(|(_, speed)| speed),
-                target_lead_gap_m: step.target_lead.map(|(gap, _)| gap),
-                target_lag_gap_m: step.target_lag.map(|(gap, _)| gap),
-                ego_speed: step.ego_speed,
-                target_lead_speed: step.target_lead.map(|(_, speed)| speed),
-                target_lag_speed: step.target_lag.map(|(_, speed)| speed),
-            }
-        })
-        .collect()
+    scene.steps.iter().map(situation).collect()
+}
+
+/// The situation of one recorded step, as the driver saw it.
+pub(crate) fn situation(step: &SeenStep) -> Situation {
+    let gap = step.preceding.map_or(f64::INFINITY, |(gap, _)| gap);
+    Situation {
+        time_headway_s: gap / step.ego_speed,
+        preceding_gap_m: gap,
+        preceding_speed: step.preceding.map(|(_, speed)| speed),
+        target_lead_gap_m: step.target_lead.map(|(gap, _)| gap),
+        target_lag_gap_m: step.target_lag.map(|(gap, _)| gap),
+        ego_speed: step.ego_speed,
+        target_lead_speed: step.target_lead.map(|(_, speed)| speed),
+        target_lag_speed: step.target_lag.map(|(_, speed)| speed),
+    }
 }

@@ -282,10 +282,7 @@ fn decision(onsets: &[Onset]) -> (Decision, f64) {
 /// say nothing more).
 fn decision_range(onsets: &[Onset]) -> (Decision, f64, f64) {
     let onsets = &reread_follower_waits(onsets);
-    let free: Vec<&Onset> = onsets
-        .iter()
-        .filter(|o| o.lead_time_gap_s.is_none() && o.lag_time_gap_s.is_none())
-        .collect();
+    let free = free_onsets(onsets);
     let informative: Vec<&Onset> = if free.is_empty() {
         onsets.iter().collect()
     } else {
@@ -332,10 +329,86 @@ fn decision_range(onsets: &[Onset]) -> (Decision, f64, f64) {
             .filter(|&(d, spread, max)| spread <= CONSISTENT_SPREAD && !contradicted(d, max))
             .min_by(|a, b| a.1.total_cmp(&b.1));
         if let Some((feature, _, threshold)) = best {
+            let threshold = revealed_threshold(&free, feature).unwrap_or(threshold);
             return (feature, threshold, threshold);
         }
     }
-    (Decision::TimeHeadway, lowest_headway, headway.1)
+    match revealed_threshold(&free, Decision::TimeHeadway) {
+        Some(threshold) => (Decision::TimeHeadway, threshold, threshold),
+        None => (Decision::TimeHeadway, lowest_headway, headway.1),
+    }
+}
+
+/// The threshold of `feature` the free onsets' scenes reveal: the middle of the
+/// interval they all allow ([`revealed_interval`]). Under a uniform belief over
+/// the interval, the start that most of it leads to in a new scene is the one
+/// its middle leads to. With one onset it is that onset's [`revealed`]
+/// midpoint; with more, the largest midpoint (the readings' threshold before)
+/// could lie outside the interval and start the next scene a step early or late
+/// (docs/experiments/0089-the-thresholds-every-scene-allows.md).
+fn revealed_threshold(free: &[&Onset], feature: Decision) -> Option<f64> {
+    revealed_interval(free, feature).map(|(lowest, highest)| 0.5 * (lowest + highest))
+}
+
+/// The onsets no target-lane gap held back: their start is the decision's.
+fn free_onsets(onsets: &[Onset]) -> Vec<&Onset> {
+    (onsets.iter())
+        .filter(|o| o.lead_time_gap_s.is_none() && o.lag_time_gap_s.is_none())
+        .collect()
+}
+
+/// Whether the threshold the readings predict with is one that the scenes of at
+/// least two free onsets reveal exactly ([`revealed_interval`]): every start is a
+/// threshold of one cue crossed at a step, as a driver who decides on that cue
+/// starts. The driver estimate, whose observation error is
+/// [`OBSERVATION_SD_S`](crate::driver::prior::OBSERVATION_SD_S) (0.2 s, two
+/// steps, for starts read from noisy paths), does not place such a start to
+/// the step; the interval does.
+pub(crate) fn threshold_revealed_by_scenes(onsets: &[Onset]) -> bool {
+    let reread = reread_follower_waits(onsets);
+    let free = free_onsets(&reread);
+    if free.len() < 2 {
+        return false;
+    }
+    let (feature, _, threshold) = decision_range(onsets);
+    revealed_threshold(&free, feature) == Some(threshold)
+}
+
+/// The thresholds of `feature` that every free onset allows, from the scenes
+/// they recorded: a start at step `k` says that the feature had fallen to the
+/// threshold there and not at the step before, `θ ∈ [x(k), x(k − 1))`, and the
+/// scenes together allow the intersection `[max x(k), min x(k − 1))`. `None`
+/// when an onset recorded no scene or is the mean of several starts in its
+/// scene ([`Onset::merged`]: a mean of starts is not a step at which the driver
+/// started), or the intervals do not intersect (a driver whose threshold is not
+/// one value): the midpoints stand.
+fn revealed_interval(free: &[&Onset], feature: Decision) -> Option<(f64, f64)> {
+    if free.is_empty() {
+        return None;
+    }
+    let value = |s: &Situation| {
+        (s.time_headway_s > 0.0)
+            .then(|| feature.of_situation(s))
+            .flatten()
+            .filter(|x| x.is_finite())
+    };
+    let (mut lowest, mut highest) = (f64::NEG_INFINITY, f64::INFINITY);
+    for onset in free {
+        if onset.observations != 1 {
+            return None;
+        }
+        let scene = onset.scene.as_ref()?;
+        let step = (onset.time_s / scene.dt).round();
+        if !(step >= 1.0 && step < scene.steps.len() as f64) {
+            return None;
+        }
+        let step = step as usize;
+        lowest = lowest.max(value(&crate::driver::situation(&scene.steps[step]))?);
+        if let Some(before) = value(&crate::driver::situation(&scene.steps[step - 1])) {
+            highest = highest.min(before);
+        }
+    }
+    (lowest < highest && highest.is_finite()).then_some((lowest, highest))
 }
 
 /// `onsets` with each start that was read as a wait for the follower
@@ -521,6 +594,7 @@ fn decision_steps(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use palc_aggregator::{SceneSteps, SeenStep};
 
     fn onset(headway: f64, ttc: f64, lag: Option<f64>) -> Onset {
         Onset {
@@ -716,6 +790,100 @@ mod tests {
                 proptest::prop_assert!(steps.iter().any(|&(i, _)| i == step), "{}", threshold);
             }
         }
+    }
+
+    /// A scene of an ego at `speed` (m/s) closing on the vehicle ahead at
+    /// `closing` (m/s) from a time headway of 3 s, the target lane empty, and the
+    /// onset of a user who decides at the time headway `threshold` in it (the
+    /// first step at which [`Situation::decides_at`] holds), read as the
+    /// readings read it.
+    fn onset_of_a_closing_scene(speed: f64, closing: f64, threshold: f64) -> Onset {
+        let dt = 0.1;
+        let steps: Vec<SeenStep> = (0..3000)
+            .map(|i| SeenStep {
+                ego_speed: speed,
+                preceding: Some((3.0 * speed - closing * dt * f64::from(i), speed - closing)),
+                target_lead: None,
+                target_lag: None,
+                safe: None,
+            })
+            .collect();
+        let scene = SceneSteps {
+            dt,
+            set_speed_mps: speed,
+            steps,
+        };
+        let seen = crate::driver::situation;
+        let start = (scene.steps.iter())
+            .position(|s| seen(s).decides_at(threshold))
+            .unwrap();
+        let headway = |i: usize| seen(&scene.steps[i]).time_headway_s;
+        Onset {
+            time_s: start as f64 * dt,
+            time_headway_s: 0.5 * (headway(start) + headway(start - 1)),
+            scene: Some(scene),
+            ..onset(0.0, 10.0, None)
+        }
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(128))]
+
+        /// Whatever the scenes a user who decides at one time headway started
+        /// in, the interval the readings keep contains that headway: a start
+        /// never rules out the user's own threshold.
+        #[test]
+        fn a_users_threshold_lies_in_the_interval_its_starts_allow(
+            threshold in 0.8f64..2.5,
+            scenes in proptest::collection::vec((10.0f64..35.0, 0.5f64..8.0), 1..6),
+        ) {
+            let onsets: Vec<Onset> = (scenes.iter())
+                .map(|&(speed, closing)| onset_of_a_closing_scene(speed, closing, threshold))
+                .collect();
+            let free: Vec<&Onset> = onsets.iter().collect();
+            let (lowest, highest) = revealed_interval(&free, Decision::TimeHeadway).unwrap();
+            proptest::prop_assert!(
+                lowest <= threshold && threshold < highest,
+                "{} not in [{}, {})", threshold, lowest, highest
+            );
+            let (feature, _, predicted) = decision_range(&onsets);
+            proptest::prop_assert_eq!(feature, Decision::TimeHeadway);
+            proptest::prop_assert!((predicted - 0.5 * (lowest + highest)).abs() < 1e-12);
+        }
+    }
+
+    /// Two scenes whose largest midpoint lies above what the other allows: the
+    /// interval still decides where the user does, the midpoint a step early.
+    #[test]
+    fn the_interval_decides_where_a_midpoint_above_it_does_not() {
+        let threshold = 1.151;
+        let coarse = onset_of_a_closing_scene(20.0, 6.0, threshold);
+        let fine = onset_of_a_closing_scene(20.0, 0.5, threshold);
+        let (lowest, highest) =
+            revealed_interval(&[&coarse, &fine], Decision::TimeHeadway).unwrap();
+        assert!(
+            lowest <= threshold && threshold < highest,
+            "[{lowest}, {highest})"
+        );
+        let largest_midpoint = coarse.time_headway_s.max(fine.time_headway_s);
+        assert!(
+            largest_midpoint > highest,
+            "{largest_midpoint} against {highest}"
+        );
+        let (_, _, predicted) = decision_range(&[coarse, fine]);
+        assert!(lowest <= predicted && predicted < highest, "{predicted}");
+    }
+
+    /// Two starts of a driver in one scene merged into their mean: the mean is
+    /// not a step the driver started at, and reveals no interval.
+    #[test]
+    fn a_mean_of_starts_reveals_no_interval() {
+        let first = onset_of_a_closing_scene(20.0, 2.0, 1.2);
+        let second = onset_of_a_closing_scene(20.0, 2.0, 1.3);
+        let mean = first.merged(&second);
+        assert!(revealed_interval(&[&first, &second], Decision::TimeHeadway).is_none());
+        assert!(revealed_interval(&[&mean, &first], Decision::TimeHeadway).is_none());
+        assert!(revealed_interval(&[&first], Decision::TimeHeadway).is_some());
     }
 
     #[test]
