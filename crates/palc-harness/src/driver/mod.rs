@@ -156,9 +156,8 @@ pub(crate) fn start_beyond_readings(
     // Where every scene's start crossed one threshold of a cue the readings
     // read, their interval places the start to the step and the estimate does
     // not (`crate::onset::threshold_revealed_by_scenes`).
-    let exact_readings = crate::onset::threshold_revealed_by_scenes(onsets);
-    let predicts =
-        beyond_the_readings >= CREDIBLE_MASS || (within_a_step >= CREDIBLE_MASS && !exact_readings);
+    let predicts = beyond_the_readings >= CREDIBLE_MASS
+        || (within_a_step >= CREDIBLE_MASS && !crate::onset::threshold_revealed_by_scenes(onsets));
     let start_s = (predicts && step < setup.situations.len()).then_some(step as f64 * setup.dt);
     CarriedEstimate { start_s, belief }
 }
