@@ -12,7 +12,7 @@ use palc_planner::{Planner, Problem, State, Weights};
 use crate::HarnessError;
 use crate::driver::{CarriedBelief, start_beyond_readings};
 use crate::lesson::scenes;
-use crate::onset::{UserLaneChange, predicted_start_s};
+use crate::onset::{UserLaneChange, predicted_start_s, threshold_revealed_by_scenes};
 use crate::setup::Setup;
 
 /// Who and where an experience is learned: the names it is saved with.
@@ -91,7 +91,12 @@ pub(crate) fn starting_experience(
                 .map_or(settled, |fitted| fitted.duration_s.max(settled));
             let estimated = start_beyond_readings(setup, &previous.onsets, lane_change);
             belief = estimated.belief;
+            // Where two or more free starts reveal one threshold of a cue the
+            // readings read, their interval places the start to the step; the
+            // estimate's predictive, with its 0.2 s observation error, does not.
+            let exact_readings = || threshold_revealed_by_scenes(&previous.onsets);
             (estimated.start_s)
+                .filter(|_| !(estimated.only_within_a_step && exact_readings()))
                 .or_else(|| predicted_start_s(setup, &previous.onsets, lane_change))
                 .map(|start| (anchor, start.min(latest)))
         }

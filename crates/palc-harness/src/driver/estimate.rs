@@ -988,9 +988,10 @@ mod tests {
             (predicted - expected).abs() < dt / 2.0,
             "{predicted} against {expected}"
         );
-        // A headway driver seen in the other scenes: its starts reveal one
-        // threshold of the time headway, and the readings place its start in the
-        // last one to the step; the estimate leaves it to them.
+        // A headway driver seen in the other scenes: the estimate is sure of its
+        // start in the last one within a step, and predicts it; its starts also
+        // reveal one threshold of the time headway, from which the readings
+        // place the start to the step (the carry's choice between the two).
         let headway = driver(Cue::TimeHeadway, 1.2);
         let seen: Vec<Onset> = (setups.iter())
             .filter_map(|s| observed(&headway, s))
@@ -1001,9 +1002,15 @@ mod tests {
             .position(|s| s.label == last.scenario)
             .unwrap();
         let dt = setups[target].dt;
-        assert!(crate::onset::threshold_revealed_by_scenes(before));
         let carried = start_beyond_readings(&setups[target], before, 2.0);
-        assert_eq!(carried.start_s, None);
+        let predicted = carried.start_s.expect("sure of the start within a step");
+        assert!(carried.only_within_a_step);
+        assert!(
+            (predicted - last.time_s).abs() < dt / 2.0,
+            "{predicted} against {}",
+            last.time_s
+        );
+        assert!(crate::onset::threshold_revealed_by_scenes(before));
         let predicted = crate::onset::predicted_start_s(&setups[target], before, 2.0)
             .expect("the readings predict a start");
         assert!(

@@ -36,10 +36,10 @@
 //! posterior mass, when 95 % of the posterior lies on models the readings
 //! cannot represent (MOBIL's incentive, a reaction after the decision;
 //! docs/experiments/0073-a-drive-of-varied-scenes.md, 0079) or 95 % of the
-//! predictive within a step of that start (0080), unless two or more starts no
-//! gap held back reveal one threshold of a cue the readings read: their
-//! interval places the start to the step, which the estimate's 0.2 s
-//! observation error does not (0089).
+//! predictive within a step of that start (0080); the carry leaves the latter
+//! to the readings where two or more starts no gap held back reveal one
+//! threshold of a cue they read: their interval places the start to the step,
+//! which the estimate's 0.2 s observation error does not (0089).
 
 mod estimate;
 mod memo;
@@ -97,12 +97,15 @@ pub(crate) struct CarriedEstimate {
     /// places [`CREDIBLE_MASS`] of the posterior on models the readings cannot
     /// represent (a cue they do not read, or a reaction after the decision) or
     /// of the posterior predictive within a step of the start it predicts, from
-    /// at least [`MIN_SCENES`] scenes, the latter unless the readings' threshold
-    /// is revealed by the scenes (`crate::onset::threshold_revealed_by_scenes`).
-    /// `None` otherwise (the readings predict),
+    /// at least [`MIN_SCENES`] scenes. `None` otherwise (the readings predict),
     /// and for a driver outside the model or a scene the estimate says it does
     /// not start in.
     pub start_s: Option<f64>,
+    /// `start_s` rests on the posterior predictive alone (95 % within a step),
+    /// not on models the readings cannot represent: the carry then leaves the
+    /// start to the readings where the scenes reveal their threshold exactly
+    /// (`crate::carry`, docs/experiments/0089-the-thresholds-every-scene-allows.md).
+    pub only_within_a_step: bool,
     /// What the estimate believed; `None` below [`MIN_SCENES`] recorded scenes,
     /// where it is not computed.
     pub belief: Option<CarriedBelief>,
@@ -132,6 +135,7 @@ pub(crate) fn start_beyond_readings(
     if estimate.outside_model() {
         return CarriedEstimate {
             start_s: None,
+            only_within_a_step: false,
             belief,
         };
     }
@@ -153,11 +157,12 @@ pub(crate) fn start_beyond_readings(
     let within_a_step: f64 = masses[step.saturating_sub(1)..(step + 2).min(masses.len() - 1)]
         .iter()
         .sum();
-    // Where every scene's start crossed one threshold of a cue the readings
-    // read, their interval places the start to the step and the estimate does
-    // not (`crate::onset::threshold_revealed_by_scenes`).
-    let predicts = beyond_the_readings >= CREDIBLE_MASS
-        || (within_a_step >= CREDIBLE_MASS && !crate::onset::threshold_revealed_by_scenes(onsets));
+    let beyond = beyond_the_readings >= CREDIBLE_MASS;
+    let predicts = beyond || within_a_step >= CREDIBLE_MASS;
     let start_s = (predicts && step < setup.situations.len()).then_some(step as f64 * setup.dt);
-    CarriedEstimate { start_s, belief }
+    CarriedEstimate {
+        start_s,
+        only_within_a_step: start_s.is_some() && !beyond,
+        belief,
+    }
 }
