@@ -238,6 +238,15 @@ enum Decision {
 }
 
 impl Decision {
+    /// The feature at `s` as a threshold decision reads it: behind a vehicle
+    /// ahead (a positive time headway), and finite.
+    fn read_at(self, s: &Situation) -> Option<f64> {
+        (s.time_headway_s > 0.0)
+            .then(|| self.of_situation(s))
+            .flatten()
+            .filter(|x| x.is_finite())
+    }
+
     fn of_situation(self, s: &Situation) -> Option<f64> {
         match self {
             Decision::TimeHeadway => Some(s.time_headway_s),
@@ -271,16 +280,40 @@ impl Decision {
 /// decision); then the most consistent of those that no held-back onset
 /// contradicts.
 fn decision(onsets: &[Onset]) -> (Decision, f64) {
-    let (feature, _, threshold) = decision_range(onsets);
-    (feature, threshold)
+    let range = decision_range(onsets);
+    (range.feature, range.highest)
 }
 
-/// [`decision`] with the lowest threshold the onsets allow: `(feature, lowest,
-/// threshold)`. The two differ only when every onset was held back and a
-/// ceiling raised the time headway's threshold above the largest headway at
-/// which the user started (the onsets bound the decision to that interval and
-/// say nothing more).
-fn decision_range(onsets: &[Onset]) -> (Decision, f64, f64) {
+/// What [`decision_range`] learned: the feature and the thresholds it allows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct DecisionRange {
+    feature: Decision,
+    /// The lowest threshold the onsets allow.
+    lowest: f64,
+    /// The threshold (the highest the onsets allow).
+    highest: f64,
+    /// How many free onsets' scenes revealed the threshold as the middle of the
+    /// interval they all allow ([`revealed_threshold`]); 0 when it is read from
+    /// the onsets' midpoints or ceilings.
+    revealed_by: usize,
+}
+
+impl DecisionRange {
+    fn one(feature: Decision, threshold: f64, revealed_by: usize) -> Self {
+        DecisionRange {
+            feature,
+            lowest: threshold,
+            highest: threshold,
+            revealed_by,
+        }
+    }
+}
+
+/// [`decision`] with the lowest threshold the onsets allow. The two differ only
+/// when every onset was held back and a ceiling raised the time headway's
+/// threshold above the largest headway at which the user started (the onsets
+/// bound the decision to that interval and say nothing more).
+fn decision_range(onsets: &[Onset]) -> DecisionRange {
     let onsets = &reread_follower_waits(onsets);
     let free = free_onsets(onsets);
     let informative: Vec<&Onset> = if free.is_empty() {
@@ -329,13 +362,20 @@ fn decision_range(onsets: &[Onset]) -> (Decision, f64, f64) {
             .filter(|&(d, spread, max)| spread <= CONSISTENT_SPREAD && !contradicted(d, max))
             .min_by(|a, b| a.1.total_cmp(&b.1));
         if let Some((feature, _, threshold)) = best {
-            let threshold = revealed_threshold(&free, feature).unwrap_or(threshold);
-            return (feature, threshold, threshold);
+            return match revealed_threshold(&free, feature) {
+                Some(revealed) => DecisionRange::one(feature, revealed, free.len()),
+                None => DecisionRange::one(feature, threshold, 0),
+            };
         }
     }
     match revealed_threshold(&free, Decision::TimeHeadway) {
-        Some(threshold) => (Decision::TimeHeadway, threshold, threshold),
-        None => (Decision::TimeHeadway, lowest_headway, headway.1),
+        Some(revealed) => DecisionRange::one(Decision::TimeHeadway, revealed, free.len()),
+        None => DecisionRange {
+            feature: Decision::TimeHeadway,
+            lowest: lowest_headway,
+            highest: headway.1,
+            revealed_by: 0,
+        },
     }
 }
 
@@ -365,13 +405,7 @@ fn free_onsets(onsets: &[Onset]) -> Vec<&Onset> {
 /// steps, for starts read from noisy paths), does not place such a start to
 /// the step; the interval does.
 pub(crate) fn threshold_revealed_by_scenes(onsets: &[Onset]) -> bool {
-    let reread = reread_follower_waits(onsets);
-    let free = free_onsets(&reread);
-    if free.len() < 2 {
-        return false;
-    }
-    let (feature, _, threshold) = decision_range(onsets);
-    revealed_threshold(&free, feature) == Some(threshold)
+    decision_range(onsets).revealed_by >= 2
 }
 
 /// The thresholds of `feature` that every free onset allows, from the scenes
@@ -386,12 +420,7 @@ fn revealed_interval(free: &[&Onset], feature: Decision) -> Option<(f64, f64)> {
     if free.is_empty() {
         return None;
     }
-    let value = |s: &Situation| {
-        (s.time_headway_s > 0.0)
-            .then(|| feature.of_situation(s))
-            .flatten()
-            .filter(|x| x.is_finite())
-    };
+    let value = |s: &Situation| feature.read_at(s);
     let (mut lowest, mut highest) = (f64::NEG_INFINITY, f64::INFINITY);
     for onset in free {
         if onset.observations != 1 {
@@ -475,7 +504,12 @@ pub(crate) fn predicted_start_s(setup: &Setup, onsets: &[Onset], duration_s: f64
     if onsets.is_empty() {
         return None;
     }
-    let (feature, lowest, threshold) = decision_range(onsets);
+    let DecisionRange {
+        feature,
+        lowest,
+        highest: threshold,
+        ..
+    } = decision_range(onsets);
     // A lead gap the user refused after deciding is below the one it needs.
     let refused = (onsets.iter())
         .filter_map(|o| o.rejected_lead_time_gap_s)
@@ -559,11 +593,7 @@ fn decision_steps(
     feature: Decision,
     (lowest, highest): (f64, f64),
 ) -> Vec<(usize, f64)> {
-    let value = |s: &Situation| {
-        (s.time_headway_s > 0.0)
-            .then(|| feature.of_situation(s))
-            .flatten()
-    };
+    let value = |s: &Situation| feature.read_at(s);
     let situations = &setup.situations;
     if lowest >= highest {
         return (situations.iter())
@@ -846,9 +876,10 @@ mod tests {
                 lowest <= threshold && threshold < highest,
                 "{} not in [{}, {})", threshold, lowest, highest
             );
-            let (feature, _, predicted) = decision_range(&onsets);
-            proptest::prop_assert_eq!(feature, Decision::TimeHeadway);
-            proptest::prop_assert!((predicted - 0.5 * (lowest + highest)).abs() < 1e-12);
+            let range = decision_range(&onsets);
+            proptest::prop_assert_eq!(range.feature, Decision::TimeHeadway);
+            proptest::prop_assert!((range.highest - 0.5 * (lowest + highest)).abs() < 1e-12);
+            proptest::prop_assert_eq!(range.revealed_by, onsets.len());
         }
     }
 
@@ -870,7 +901,7 @@ mod tests {
             largest_midpoint > highest,
             "{largest_midpoint} against {highest}"
         );
-        let (_, _, predicted) = decision_range(&[coarse, fine]);
+        let predicted = decision_range(&[coarse, fine]).highest;
         assert!(lowest <= predicted && predicted < highest, "{predicted}");
     }
 
