@@ -453,11 +453,13 @@ fn second_derivative_basis(tau: f64) -> Vec<f64> {
 }
 
 /// `l(τ) = Σ c_k B_k(τ)`.
+///
+/// The terms of [`bernstein_basis_of`], each times its coefficient, summed in
+/// order without collecting the basis (a profile is read at every step).
 fn bernstein_value(c: &[f64], tau: f64) -> f64 {
-    bernstein_basis_of(c.len() - 1, tau)
-        .iter()
-        .zip(c)
-        .map(|(b, c)| b * c)
+    let n = c.len() - 1;
+    (c.iter().enumerate())
+        .map(|(k, c)| binomial(n, k) * tau.powi(k as i32) * (1.0 - tau).powi((n - k) as i32) * c)
         .sum()
 }
 

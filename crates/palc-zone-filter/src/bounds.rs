@@ -4,8 +4,9 @@
 use serde::{Deserialize, Serialize};
 
 use crate::{
+    certain_sign::CertainSign,
     error::{ZoneError, check_finite},
-    features::{FeatureInput, MAX_FEATURES, features_into, write_checked_features},
+    features::{FeatureInput, FeatureSet, MAX_FEATURES, features_into, write_checked_features},
     gaussian::Fitted,
     model::ZoneModel,
 };
@@ -289,6 +290,9 @@ pub fn project(boundary: &StepBoundary, reference_l: f64, projection: Projection
     }
 }
 
+/// The zone's boundary on the line of `scene`: the grid of `config` classified
+/// from the lower edge up, each change of class refined by bisection, and the
+/// grid points whose class is already certain ([`CertainSign`]) not classified.
 fn boundary_on_line(
     model: &ZoneModel,
     fitted: &Fitted,
@@ -296,6 +300,20 @@ fn boundary_on_line(
     config: &BoundsConfig,
 ) -> Result<StepBoundary, ZoneError> {
     let set = model.config().feature_set;
+    let [lo, hi] = config.lateral_range;
+    let certain = CertainSign::new(fitted, set, hi - lo);
+    scan_line(set, fitted, scene, config, certain)
+}
+
+/// [`boundary_on_line`] with the certainty it skips by (`None`: every grid
+/// point classified).
+fn scan_line(
+    set: FeatureSet,
+    fitted: &Fitted,
+    scene: &StepScene,
+    config: &BoundsConfig,
+    certain: Option<CertainSign<'_>>,
+) -> Result<StepBoundary, ZoneError> {
     let [lo, hi] = config.lateral_range;
     let mut buffer = [0.0; MAX_FEATURES];
     let at_l = |l: f64| FeatureInput {
@@ -308,8 +326,8 @@ fn boundary_on_line(
     // The scene is checked once, at the lower edge; every other point of the
     // line differs only in its finite `ego_l`, so it passes the same checks.
     features_into(set, &at_l(lo), &mut buffer)?;
-    let mut log_odds = |l: f64| -> Result<f64, ZoneError> {
-        write_checked_features(set, &at_l(l), &mut buffer);
+    let log_odds = |l: f64, buffer: &mut [f64; MAX_FEATURES]| -> Result<f64, ZoneError> {
+        write_checked_features(set, &at_l(l), buffer);
         let a = fitted.log_odds(&buffer[..set.dimension()]);
         if a.is_nan() {
             return Err(ZoneError::Overflow {
@@ -320,16 +338,31 @@ fn boundary_on_line(
     };
     let cells = ((hi - lo) / config.grid_step).ceil().max(1.0) as usize;
     let at = |k: usize| lo + (hi - lo) * k as f64 / cells as f64;
-    let mut previous_safe = log_odds(lo)? > 0.0;
+    let cell = (hi - lo) / cells as f64;
+    // The grid points after the last one classified whose class is certain
+    // (`certain_sign`): the scan takes their class without classifying them.
+    let certain_cells = |value: f64, features: &[f64]| -> usize {
+        let reach = certain.map_or(0.0, |c| c.reach(&features[..set.dimension()], value));
+        (reach / cell).floor().min(cells as f64) as usize
+    };
+    let first = log_odds(lo, &mut buffer)?;
+    let mut skip = certain_cells(first, &buffer);
+    let mut previous_safe = first > 0.0;
     let safe_at_lower_edge = previous_safe;
     let mut crossings = Vec::new();
     for k in 1..=cells {
-        let safe = log_odds(at(k))? > 0.0;
+        if skip > 0 {
+            skip -= 1;
+            continue;
+        }
+        let value = log_odds(at(k), &mut buffer)?;
+        skip = certain_cells(value, &buffer);
+        let safe = value > 0.0;
         if safe != previous_safe {
             let (mut a, mut b) = (at(k - 1), at(k));
             while b - a > config.tolerance {
                 let mid = 0.5 * (a + b);
-                if (log_odds(mid)? > 0.0) == previous_safe {
+                if (log_odds(mid, &mut buffer)? > 0.0) == previous_safe {
                     a = mid;
                 } else {
                     b = mid;
@@ -348,4 +381,105 @@ fn boundary_on_line(
         safe_at_lower_edge,
         lateral_range: config.lateral_range,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::*;
+    use crate::{Discriminant, Label, Sample, ZoneConfig, features};
+
+    fn feature_set() -> impl Strategy<Value = FeatureSet> {
+        prop_oneof![
+            Just(FeatureSet::Paper),
+            Just(FeatureSet::NoDistance),
+            Just(FeatureSet::TimeGap)
+        ]
+    }
+
+    /// A scene: the ego at `s`, a preceding vehicle ahead in its lane and an
+    /// adjacent one in the target lane.
+    fn scene() -> impl Strategy<Value = StepScene> {
+        (
+            0.0..200.0f64,
+            5.0..35.0f64,
+            3.0..80.0f64,
+            -0.3..0.3f64,
+            -60.0..60.0f64,
+            3.2..3.8f64,
+        )
+            .prop_map(|(s, v, ahead, pl, beside, al)| StepScene {
+                ego_s: s,
+                reference_l: 0.0,
+                ego_speed: v,
+                preceding: [s + ahead, pl],
+                adjacent: [s + beside, al],
+            })
+    }
+
+    /// Positions of `scenes` labelled safe below `split` (m) and unsafe above,
+    /// a fraction of them flipped so that the classes overlap.
+    fn samples(set: FeatureSet, scenes: &[StepScene], split: f64, flip: u32) -> Vec<Sample> {
+        let mut out = Vec::new();
+        for (i, scene) in scenes.iter().enumerate() {
+            for j in 0..12 {
+                let l = -1.5 + 0.55 * j as f64 + 0.01 * i as f64;
+                let input = FeatureInput {
+                    ego_s: scene.ego_s,
+                    ego_l: l,
+                    ego_speed: scene.ego_speed,
+                    preceding: scene.preceding,
+                    adjacent: scene.adjacent,
+                };
+                let mut safe = l < split;
+                if (i as u32 * 12 + j) % 7 < flip {
+                    safe = !safe;
+                }
+                let label = if safe { Label::Safe } else { Label::Unsafe };
+                out.push(Sample::new(features(set, &input).unwrap(), label));
+            }
+        }
+        out
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(96))]
+
+        /// The scan that skips the grid points whose class is certain finds the
+        /// boundary of the scan that classifies every point, crossing for
+        /// crossing and bit for bit.
+        #[test]
+        fn skipping_certain_points_finds_the_boundary_of_the_full_scan(
+            set in feature_set(),
+            seen in prop::collection::vec(scene(), 3..8),
+            split in 0.0..3.5f64,
+            flip in 0u32..3,
+            queries in prop::collection::vec(scene(), 1..6),
+            grid_step in 0.01..0.3f64,
+        ) {
+            let config = ZoneConfig {
+                feature_set: set,
+                discriminant: Discriminant::Linear,
+                ..ZoneConfig::default()
+            };
+            let Ok(model) = ZoneModel::fit(config, &samples(set, &seen, split, flip)) else {
+                return Ok(());
+            };
+            let Ok(fitted) = model.fitted() else { return Ok(()) };
+            let bounds = BoundsConfig {
+                grid_step,
+                tolerance: grid_step.min(1e-3),
+                ..BoundsConfig::default()
+            };
+            let [lo, hi] = bounds.lateral_range;
+            let certain = CertainSign::new(fitted, set, hi - lo);
+            prop_assert!(certain.is_some());
+            for query in &queries {
+                let skipping = scan_line(set, fitted, query, &bounds, certain).unwrap();
+                let full = scan_line(set, fitted, query, &bounds, None).unwrap();
+                prop_assert_eq!(skipping, full);
+            }
+        }
+    }
 }

@@ -36,6 +36,7 @@
 #![cfg_attr(not(test), warn(clippy::unwrap_used, clippy::expect_used))]
 
 mod bounds;
+mod certain_sign;
 mod config;
 mod error;
 mod features;
