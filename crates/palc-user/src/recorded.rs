@@ -421,10 +421,41 @@ impl FitProblem {
     }
 }
 
-/// Binomial coefficient `C(n, k)` as a float (exact for the degrees used here).
+/// Binomial coefficient `C(n, k)` as a float (exact for the degrees used here):
+/// [`DEGREE_BINOMIALS`] for degree [`DEGREE`], computed otherwise.
 fn binomial(n: usize, k: usize) -> f64 {
-    (0..k).fold(1.0, |acc, i| acc * (n - i) as f64 / (i + 1) as f64)
+    if n == DEGREE {
+        DEGREE_BINOMIALS[k]
+    } else {
+        binomial_product(n, k)
+    }
 }
+
+/// `C(n, k) = Π_{i<k} (n − i) / (i + 1)`, multiplied and divided in that order.
+const fn binomial_product(n: usize, k: usize) -> f64 {
+    let mut acc = 1.0;
+    let mut i = 0;
+    while i < k {
+        acc = acc * (n - i) as f64 / (i + 1) as f64;
+        i += 1;
+    }
+    acc
+}
+
+/// `C(DEGREE, k)` for every `k`, computed once at compile time by
+/// [`binomial_product`]: a profile is read at every step, and the coefficients'
+/// 136 dependent multiplications and divisions per reading cost more than the
+/// basis itself. Compile-time floating-point arithmetic is IEEE's, so the table
+/// holds the bits the product gives at run time.
+const DEGREE_BINOMIALS: [f64; DEGREE + 1] = {
+    let mut row = [0.0; DEGREE + 1];
+    let mut k = 0;
+    while k <= DEGREE {
+        row[k] = binomial_product(DEGREE, k);
+        k += 1;
+    }
+    row
+};
 
 /// The Bernstein basis of degree `n` at `τ`.
 fn bernstein_basis_of(n: usize, tau: f64) -> Vec<f64> {
@@ -467,6 +498,18 @@ fn bernstein_value(c: &[f64], tau: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::profile::quintic;
+
+    #[test]
+    fn the_degrees_binomials_are_the_products_bits_and_exact() {
+        let mut exact = 1u64;
+        for (k, &table) in DEGREE_BINOMIALS.iter().enumerate() {
+            // `std::hint::black_box` keeps the product a run-time computation.
+            let product = binomial_product(std::hint::black_box(DEGREE), k);
+            assert_eq!(table.to_bits(), product.to_bits(), "C({DEGREE}, {k})");
+            assert_eq!(table, exact as f64, "C({DEGREE}, {k})");
+            exact = exact * (DEGREE - k) as u64 / (k + 1) as u64;
+        }
+    }
 
     /// A deterministic noise of roughly unit variance (a hash, not a generator,
     /// so that the tests need no seed plumbing).
