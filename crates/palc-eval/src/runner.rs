@@ -228,8 +228,20 @@ impl<E: Executor> Work<'_, E> {
         let spec = self.specs[id];
         let of = self.original[id];
         if of != id {
-            let output = repeated(spec, of, &state.shared);
+            let mut output = repeated(spec, of, &state.shared);
             state.shared.served(of);
+            // A repeat refused for want of experience names its own source, as
+            // computed on its own it would (a shard may not hold the original).
+            if let (
+                Status::Refused {
+                    refusal: None,
+                    reason,
+                },
+                Some(source),
+            ) = (&mut output.0.status, spec.experience_from)
+            {
+                *reason = no_experience_reason(&source_label(&state.rows, source));
+            }
             return Some((id, Start::Repeat(Box::new(output))));
         }
         let source = spec.experience_from.map(|source| {
@@ -244,8 +256,7 @@ impl<E: Executor> Work<'_, E> {
             match experience {
                 Some(experience) => Source::Experience(experience),
                 None => Source::Nothing {
-                    label: (state.rows.get(source).and_then(Option::as_ref))
-                        .map_or_else(|| "none".to_owned(), RunSpec::label_of),
+                    label: source_label(&state.rows, source),
                 },
             }
         });
@@ -285,9 +296,8 @@ impl<E: Executor> Work<'_, E> {
             // refused) starts from scratch.
             Some(Source::Nothing { .. }) if spec.experiment == Experiment::Drive => run(None),
             Some(Source::Nothing { label }) => {
-                let reason = format!("no experience to start from: source run {label}");
                 let status = Status::Refused {
-                    reason,
+                    reason: no_experience_reason(&label),
                     refusal: None,
                 };
                 let row = RunRow::without_result(spec.clone(), status, self.executor.cap(), 0.0);
@@ -353,6 +363,18 @@ fn repeated<X: Clone>(
             (RunRow::without_result(spec.clone(), status, 0, 0.0), None)
         }
     }
+}
+
+/// The label of run `source` for a refusal that names it: its spec and status,
+/// or "none" when it has no row.
+fn source_label(rows: &[Option<RunRow>], source: usize) -> String {
+    (rows.get(source).and_then(Option::as_ref)).map_or_else(|| "none".to_owned(), RunSpec::label_of)
+}
+
+/// Why a run whose source, `label`, handed on no experience is refused
+/// ([`crate::results::NO_EXPERIENCE_SOURCE`]).
+fn no_experience_reason(label: &str) -> String {
+    format!("no experience to start from: source run {label}")
 }
 
 /// What a run that learned nothing hands on: a drive goes on through a scene it
@@ -521,6 +543,38 @@ pub(crate) mod tests {
             computed(&shared) < computed(&every),
             "the plan repeats runs (transfer and matrix pairs), computed once"
         );
+    }
+
+    /// The ablation's `paper` rung repeats the grid's `paper` runs, and its
+    /// transfer runs repeat the grid's transfer runs while learning from the
+    /// rung's own runs: where that source is refused, the repeat's refusal names
+    /// its own source, as computing it would (and as a shard that holds only the
+    /// ablation does).
+    #[test]
+    fn a_repeat_refused_for_want_of_experience_names_its_own_source() {
+        let mut selection = plan::tests::selection();
+        selection.ablation = crate::ablation::AblationConfig {
+            users: vec!["deterministic".into()],
+            rungs: vec![crate::ablation::RungConfig {
+                name: "paper".into(),
+                change: "the printed method".into(),
+                method: Some(palc_harness::Method::Paper),
+                aggregator: Default::default(),
+            }],
+        };
+        let plan = plan::expand(&selection, &plan::tests::testbed()).unwrap();
+        let counting = |share| Counting {
+            share,
+            computed: Default::default(),
+        };
+        let all = execute(&plan, &counting(false), 2, &NoProgress).unwrap();
+        let once = execute(&plan, &counting(true), 2, &NoProgress).unwrap();
+        let ablation_refused = (once.iter())
+            .filter(|row| row.spec.experiment == Experiment::AblationTransfer)
+            .filter(|row| matches!(row.status, Status::Refused { refusal: None, .. }))
+            .count();
+        assert!(ablation_refused > 0, "the plan has such repeats");
+        assert_eq!(all, once);
     }
 
     /// Cancels once `after` runs have finished, counting the runs finished.
