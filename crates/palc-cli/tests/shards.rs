@@ -13,14 +13,16 @@ fn workspace_file(path: &str) -> PathBuf {
 }
 
 /// A small evaluation with transfer runs (each learns from a grid run, so the
-/// shards must keep them together).
+/// shards must keep them together) and an ablation whose `paper` rung repeats
+/// the grid's and the transfer's `paper` runs: shared runs, computed once in
+/// whichever shard holds their original and handed to their repeats.
 fn config(dir: &Path, seed: u64) -> PathBuf {
     let base = workspace_file("configs/learn.toml");
     let text = format!(
         r#"base = "{base}"
 
 [grid]
-methods = ["palc"]
+methods = ["paper", "palc"]
 speed_cases = ["collector-high", "collector-slow"]
 headways_m = [40.0]
 styles = ["aggressive", "neutral"]
@@ -33,7 +35,21 @@ name = "deterministic"
 source = "next-speed-case"
 users = ["deterministic"]
 
+[ablation]
+users = ["deterministic"]
+
+[[ablation.rungs]]
+name = "paper"
+change = "the printed method"
+method = "paper"
+
+[[ablation.rungs]]
+name = "labels"
+change = "palc's labels"
+method = "palc"
+
 [drive]
+methods = ["palc"]
 users = ["deterministic"]
 lane_changes = 12
 seed = {seed}

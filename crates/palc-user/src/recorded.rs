@@ -457,11 +457,14 @@ const DEGREE_BINOMIALS: [f64; DEGREE + 1] = {
     row
 };
 
+/// The Bernstein polynomial `B_k^n(τ) = C(n, k) τ^k (1 − τ)^(n−k)`.
+fn bernstein_term(n: usize, k: usize, tau: f64) -> f64 {
+    binomial(n, k) * tau.powi(k as i32) * (1.0 - tau).powi((n - k) as i32)
+}
+
 /// The Bernstein basis of degree `n` at `τ`.
 fn bernstein_basis_of(n: usize, tau: f64) -> Vec<f64> {
-    (0..=n)
-        .map(|k| binomial(n, k) * tau.powi(k as i32) * (1.0 - tau).powi((n - k) as i32))
-        .collect()
+    (0..=n).map(|k| bernstein_term(n, k, tau)).collect()
 }
 
 /// The Bernstein basis of degree [`DEGREE`] at `τ`.
@@ -490,7 +493,7 @@ fn second_derivative_basis(tau: f64) -> Vec<f64> {
 fn bernstein_value(c: &[f64], tau: f64) -> f64 {
     let n = c.len() - 1;
     (c.iter().enumerate())
-        .map(|(k, c)| binomial(n, k) * tau.powi(k as i32) * (1.0 - tau).powi((n - k) as i32) * c)
+        .map(|(k, c)| bernstein_term(n, k, tau) * c)
         .sum()
 }
 
