@@ -299,7 +299,7 @@ impl<'a> SceneView<'a> {
 
 /// How far each start step of a scene lies from the observed start, and the
 /// log-likelihood it costs: computed once per step (a scene has a few hundred)
-/// rather than once per hypothesis (1.6 million), with the same arithmetic.
+/// rather than once per hypothesis (2.7 million), with the same arithmetic.
 struct Misfit {
     /// `(error_s, penalty)` per start step; the last entry is for [`NEVER`].
     per_step: Vec<(f64, f64)>,

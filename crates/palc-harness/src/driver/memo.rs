@@ -4,11 +4,11 @@
 //! A drive carries its experience into a new scene after every lane change, and
 //! each carry estimates the driver from every scene seen so far: the scenes of
 //! the carry before and one more. Recomputed from the prior, a drive of `n` lane
-//! changes reads `n²/2` scenes over the grid's 1.6 million models; extended, `n`. The
+//! changes reads `n²/2` scenes over the grid's 2.7 million models; extended, `n`. The
 //! posterior is a sum over scenes in their order, so an extended one is bit for
 //! bit the one recomputed (a test checks it).
 //!
-//! The memo holds [`capacity`] posteriors (40 MB each, with their weights), the most recently used
+//! The memo holds [`capacity`] posteriors (68 MB each, with their weights), the most recently used
 //! last; an entry serves an estimate whose scenes begin with the entry's, and,
 //! when a scene carries the safety layer's verdicts (which depend on the lane
 //! change's duration), whose duration is the entry's.
