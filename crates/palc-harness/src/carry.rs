@@ -12,7 +12,9 @@ use palc_planner::{Planner, Problem, State, Weights};
 use crate::HarnessError;
 use crate::driver::{CarriedBelief, start_beyond_readings};
 use crate::lesson::scenes;
-use crate::onset::{UserLaneChange, predicted_start_s, threshold_revealed_by_scenes};
+use crate::onset::{
+    UserLaneChange, predicted_start_s, readings_explain, threshold_revealed_by_scenes,
+};
 use crate::setup::Setup;
 
 /// Who and where an experience is learned: the names it is saved with.
@@ -97,6 +99,12 @@ pub(crate) fn starting_experience(
             let exact_readings = || threshold_revealed_by_scenes(&previous.onsets);
             (estimated.start_s)
                 .filter(|_| !(estimated.only_within_a_step && exact_readings()))
+                // Where no feature the readings read is consistent across the
+                // scenes, their own model does not explain them: the estimate's
+                // most probable start, however unsure (0095).
+                .or_else(|| {
+                    (estimated.most_likely_s).filter(|_| !readings_explain(&previous.onsets))
+                })
                 .or_else(|| predicted_start_s(setup, &previous.onsets, lane_change))
                 .map(|start| (anchor, start.min(latest)))
         }

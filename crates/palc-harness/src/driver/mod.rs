@@ -39,7 +39,10 @@
 //! predictive within a step of that start (0080); the carry leaves the latter
 //! to the readings where two or more starts no gap held back reveal one
 //! threshold of a cue they read: their interval places the start to the step,
-//! which the estimate's 0.2 s observation error does not (0089).
+//! which the estimate's 0.2 s observation error does not (0089). Where no
+//! feature the readings read is consistent across the free starts (their own
+//! model contradicted), the estimate's most probable start step predicts
+//! however unsure it is (0095).
 
 mod estimate;
 mod memo;
@@ -106,6 +109,10 @@ pub(crate) struct CarriedEstimate {
     /// start to the readings where the scenes reveal their threshold exactly
     /// (`crate::carry`, docs/experiments/0089-the-thresholds-every-scene-allows.md).
     pub only_within_a_step: bool,
+    /// The start step with the largest posterior predictive mass (s), however
+    /// small that mass, from at least [`MIN_SCENES`] scenes; `None` where
+    /// `start_s` is.
+    pub most_likely_s: Option<f64>,
     /// What the estimate believed; `None` below [`MIN_SCENES`] recorded scenes,
     /// where it is not computed.
     pub belief: Option<CarriedBelief>,
@@ -136,6 +143,7 @@ pub(crate) fn start_beyond_readings(
         return CarriedEstimate {
             start_s: None,
             only_within_a_step: false,
+            most_likely_s: None,
             belief,
         };
     }
@@ -163,6 +171,7 @@ pub(crate) fn start_beyond_readings(
     CarriedEstimate {
         start_s,
         only_within_a_step: start_s.is_some() && !beyond,
+        most_likely_s: (step < setup.situations.len()).then_some(step as f64 * setup.dt),
         belief,
     }
 }

@@ -51,4 +51,6 @@ mod prediction;
 pub(crate) use fit::Shape;
 pub(crate) use fit::UserLaneChange;
 pub(crate) use own_shape::OwnShape;
-pub(crate) use prediction::{onset_at, predicted_start_s, threshold_revealed_by_scenes};
+pub(crate) use prediction::{
+    onset_at, predicted_start_s, readings_explain, threshold_revealed_by_scenes,
+};

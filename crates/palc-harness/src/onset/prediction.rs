@@ -296,6 +296,9 @@ struct DecisionRange {
     /// interval they all allow ([`revealed_threshold`]); 0 when it is read from
     /// the onsets' midpoints or ceilings.
     revealed_by: usize,
+    /// One feature is consistent across the free onsets (or there are fewer
+    /// than two): the readings' own model explains their scenes.
+    explained: bool,
 }
 
 impl DecisionRange {
@@ -305,6 +308,7 @@ impl DecisionRange {
             lowest: threshold,
             highest: threshold,
             revealed_by,
+            explained: true,
         }
     }
 }
@@ -368,13 +372,18 @@ fn decision_range(onsets: &[Onset]) -> DecisionRange {
             };
         }
     }
+    let explained = !headway_fails;
     match revealed_threshold(&free, Decision::TimeHeadway) {
-        Some(revealed) => DecisionRange::one(Decision::TimeHeadway, revealed, free.len()),
+        Some(revealed) => DecisionRange {
+            explained,
+            ..DecisionRange::one(Decision::TimeHeadway, revealed, free.len())
+        },
         None => DecisionRange {
             feature: Decision::TimeHeadway,
             lowest: lowest_headway,
             highest: headway.1,
             revealed_by: 0,
+            explained,
         },
     }
 }
@@ -406,6 +415,12 @@ fn free_onsets(onsets: &[Onset]) -> Vec<&Onset> {
 /// the step; the interval does.
 pub(crate) fn threshold_revealed_by_scenes(onsets: &[Onset]) -> bool {
     decision_range(onsets).revealed_by >= 2
+}
+
+/// Whether one decision feature of the readings is consistent across the free
+/// onsets: where none is, their own model does not explain the scenes.
+pub(crate) fn readings_explain(onsets: &[Onset]) -> bool {
+    decision_range(onsets).explained
 }
 
 /// The thresholds of `feature` that every free onset allows, from the scenes
@@ -686,6 +701,32 @@ mod tests {
         // An onset held back by a gap does not set the decision.
         let held = [onset(1.2, 10.0, None), onset(0.3, 2.0, Some(0.1))];
         assert_eq!(decision(&held), (Decision::TimeHeadway, 1.2));
+    }
+
+    #[test]
+    fn the_readings_explain_their_onsets_while_one_feature_is_consistent() {
+        // One scene, or scenes that agree on the headway or on another feature.
+        assert!(readings_explain(&[onset(1.2, 10.0, None)]));
+        assert!(readings_explain(&[
+            onset(1.2, 10.0, None),
+            onset(1.21, 5.0, None)
+        ]));
+        assert!(readings_explain(&[
+            onset(1.6, 8.0, None),
+            onset(0.8, 8.1, None)
+        ]));
+        // No feature agrees across the two scenes: the headway (and the gap,
+        // twenty metres a second of it here) a third apart, the time to
+        // collision half.
+        assert!(!readings_explain(&[
+            onset(1.2, 10.0, None),
+            onset(0.8, 5.0, None)
+        ]));
+        // A held-back start says nothing about consistency of free ones.
+        assert!(readings_explain(&[
+            onset(1.2, 10.0, None),
+            onset(0.8, 5.0, Some(0.2))
+        ]));
     }
 
     #[test]
