@@ -981,12 +981,21 @@ mod tests {
             "{}",
             estimate.describe()
         );
-        let predicted = start_beyond_readings(&setups[target], &seen, 2.0).start_s;
-        let predicted = predicted.expect("the scenes single the incentive out");
+        let carried = start_beyond_readings(&setups[target], &seen, 2.0);
+        let predicted = carried
+            .start_s
+            .expect("the scenes single the incentive out");
         let dt = setups[target].dt;
         assert!(
             (predicted - expected).abs() < dt / 2.0,
             "{predicted} against {expected}"
+        );
+        // The estimate's most probable start is the one it predicts; from one
+        // scene it has none.
+        assert_eq!(carried.most_likely_s, Some(predicted));
+        assert_eq!(
+            start_beyond_readings(&setups[target], &seen[..1], 2.0).most_likely_s,
+            None
         );
         // A headway driver seen in the other scenes: the estimate is sure of its
         // start in the last one within a step, and predicts it; its starts also
