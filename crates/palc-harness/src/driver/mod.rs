@@ -109,9 +109,11 @@ pub(crate) struct CarriedEstimate {
     /// start to the readings where the scenes reveal their threshold exactly
     /// (`crate::carry`, docs/experiments/0089-the-thresholds-every-scene-allows.md).
     pub only_within_a_step: bool,
-    /// The start step with the largest posterior predictive mass (s), however
-    /// small that mass, from at least [`MIN_SCENES`] scenes; `None` where
-    /// `start_s` is.
+    /// The start (s) of the step with the largest posterior predictive mass,
+    /// however small that mass; the carry uses it where the readings' own
+    /// model is contradicted (`crate::onset::readings_explain`). `None` below
+    /// [`MIN_SCENES`] recorded scenes, for a driver outside the model, and
+    /// when the estimate says the driver does not start in this scene.
     pub most_likely_s: Option<f64>,
     /// What the estimate believed; `None` below [`MIN_SCENES`] recorded scenes,
     /// where it is not computed.

@@ -296,8 +296,10 @@ struct DecisionRange {
     /// interval they all allow ([`revealed_threshold`]); 0 when it is read from
     /// the onsets' midpoints or ceilings.
     revealed_by: usize,
-    /// One feature is consistent across the free onsets (or there are fewer
-    /// than two): the readings' own model explains their scenes.
+    /// The readings' own model explains the onsets: the feature decided on
+    /// is consistent across them (within [`CONSISTENT_SPREAD`], over the free
+    /// onsets, or over all when none is free) and no held-back start
+    /// contradicts it. Always so for a single onset.
     explained: bool,
 }
 
@@ -417,8 +419,10 @@ pub(crate) fn threshold_revealed_by_scenes(onsets: &[Onset]) -> bool {
     decision_range(onsets).revealed_by >= 2
 }
 
-/// Whether one decision feature of the readings is consistent across the free
-/// onsets: where none is, their own model does not explain the scenes.
+/// Whether the readings' own model explains `onsets` ([`DecisionRange`]'s
+/// `explained`): where no feature is consistent across the scenes, the
+/// readings fall back to the time headway, which their scenes contradict
+/// (docs/experiments/0095-a-wait-weighed-by-the-prior-and-readings-that-contradict-themselves.md).
 pub(crate) fn readings_explain(onsets: &[Onset]) -> bool {
     decision_range(onsets).explained
 }
