@@ -169,11 +169,12 @@ pub(crate) fn start_beyond_readings(
         .sum();
     let beyond = beyond_the_readings >= CREDIBLE_MASS;
     let predicts = beyond || within_a_step >= CREDIBLE_MASS;
-    let start_s = (predicts && step < setup.situations.len()).then_some(step as f64 * setup.dt);
+    let most_likely_s = (step < setup.situations.len()).then_some(step as f64 * setup.dt);
+    let start_s = most_likely_s.filter(|_| predicts);
     CarriedEstimate {
         start_s,
         only_within_a_step: start_s.is_some() && !beyond,
-        most_likely_s: (step < setup.situations.len()).then_some(step as f64 * setup.dt),
+        most_likely_s,
         belief,
     }
 }
