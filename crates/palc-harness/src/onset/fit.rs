@@ -650,6 +650,35 @@ mod tests {
         }
     }
 
+    /// A lane change in neither base whose lateral acceleration falls from its
+    /// start on while its lateral speed still grows, as a recorded human onset's
+    /// does past its peak: `1.6 x^1.7` over the first half, then
+    /// `1 − q (1 − x)^r` with position and speed continuous at the middle.
+    fn onset_past_its_peak(x: f64) -> f64 {
+        let x = x.clamp(0.0, 1.0);
+        let (c, n) = (1.6, 1.7);
+        let (at, speed) = (c * 0.5_f64.powf(n), c * n * 0.5_f64.powf(n - 1.0));
+        let r = 0.5 * speed / (1.0 - at);
+        let q = (1.0 - at) / 0.5_f64.powf(r);
+        if x <= 0.5 {
+            c * x.powf(n)
+        } else {
+            1.0 - q * (1.0 - x).powf(r)
+        }
+    }
+
+    #[test]
+    fn an_onset_seen_past_its_acceleration_peak_is_not_placed_early() {
+        let (dt, start, duration) = (0.1, 3.17, 4.0);
+        let driven: Vec<f64> = (0..120)
+            .map(|i| 3.5 * onset_past_its_peak((i as f64 * dt - start) / duration))
+            .collect();
+        let takeover = driven.iter().position(|&l| l > 0.3).unwrap();
+        let fitted = UserLaneChange::fit_lesson(&driven, takeover, dt, 3.5, None).unwrap();
+        assert!(fitted.onset.is_some(), "{fitted:?}");
+        assert!((fitted.start_s - start).abs() < 0.05, "{fitted:?}");
+    }
+
     #[test]
     fn the_start_of_a_shape_in_no_model_is_its_onsets() {
         let (dt, start, duration) = (0.1, 4.23, 3.0);
