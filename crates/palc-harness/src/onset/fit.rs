@@ -667,27 +667,36 @@ mod tests {
         }
     }
 
-    #[test]
-    fn an_onset_seen_past_its_acceleration_peak_is_not_placed_early() {
-        let (dt, start, duration) = (0.1, 3.17, 4.0);
+    /// A lane change of `shape` (fraction of the lane at each fraction of its
+    /// duration) from `start` over `duration` at steps of 0.1 s, taken over at
+    /// the paper's 0.3 m, already moving: what was driven, the takeover's step
+    /// and the lesson's fit.
+    fn fitted_after_takeover(
+        shape: fn(f64) -> f64,
+        start: f64,
+        duration: f64,
+    ) -> (Vec<f64>, usize, UserLaneChange) {
+        let dt = 0.1;
         let driven: Vec<f64> = (0..120)
-            .map(|i| 3.5 * onset_past_its_peak((i as f64 * dt - start) / duration))
+            .map(|i| 3.5 * shape((i as f64 * dt - start) / duration))
             .collect();
         let takeover = driven.iter().position(|&l| l > 0.3).unwrap();
         let fitted = UserLaneChange::fit_lesson(&driven, takeover, dt, 3.5, None).unwrap();
+        (driven, takeover, fitted)
+    }
+
+    #[test]
+    fn an_onset_seen_past_its_acceleration_peak_is_not_placed_early() {
+        let start = 3.17;
+        let (_, _, fitted) = fitted_after_takeover(onset_past_its_peak, start, 4.0);
         assert!(fitted.onset.is_some(), "{fitted:?}");
         assert!((fitted.start_s - start).abs() < 0.05, "{fitted:?}");
     }
 
     #[test]
     fn the_start_of_a_shape_in_no_model_is_its_onsets() {
-        let (dt, start, duration) = (0.1, 4.23, 3.0);
-        let driven: Vec<f64> = (0..120)
-            .map(|i| 3.5 * quadratic_onset((i as f64 * dt - start) / duration))
-            .collect();
-        // Taken over at the paper's 0.3 m, already moving.
-        let takeover = driven.iter().position(|&l| l > 0.3).unwrap();
-        let fitted = UserLaneChange::fit_lesson(&driven, takeover, dt, 3.5, None).unwrap();
+        let (dt, start) = (0.1, 4.23);
+        let (driven, takeover, fitted) = fitted_after_takeover(quadratic_onset, start, 3.0);
         assert!(fitted.onset.is_some(), "{fitted:?}");
         assert!((fitted.start_s - start).abs() < 0.03, "{fitted:?}");
         // Before the takeover the path follows the onset, and meets what was
