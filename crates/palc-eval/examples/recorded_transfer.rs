@@ -7,7 +7,10 @@
 //!   run's experience is anchored at against the driver's own start, the last
 //!   step its expected path is at rest.
 //! - `transfer`: every transfer run; the carried plan's crossing of a tenth of
-//!   the lane against the driver's, and the takeovers.
+//!   the lane against the driver's, the takeovers, and the source's anchor
+//!   against the driver's start there (what the plan's error would be with an
+//!   exact anchor is summed up last;
+//!   docs/experiments/0096-an-onset-past-its-acceleration-peak.md).
 //!
 //! Each prints one line per run and the spread of the errors.
 #![allow(clippy::print_stdout)]
@@ -67,6 +70,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let harness = evaluation.harness();
     let f = |x: Option<f64>| x.map_or("-".to_owned(), |x| format!("{x:.2}"));
     let mut errors = Vec::new();
+    // (`transfer`) the plans' errors had the source's anchor been the driver's start.
+    let mut errors_with_exact_anchors = Vec::new();
     match mode.as_str() {
         "anchors" => {
             for spec in runs(Experiment::Grid) {
@@ -120,21 +125,36 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let onset = source.experience.onsets.last();
                 let wait = onset.and_then(|o| o.follower_wait_time_headway_s);
                 let lag = onset.and_then(|o| o.lag_time_gap_s);
+                // The anchor the plan was carried by, against the driver's own
+                // start in the source: an anchor `δ` early puts the plan `δ`
+                // late, however well the start is predicted.
+                let source_first = &source.records[0];
+                let anchor_error = (source.experience.anchor_s)
+                    .zip(own_start_s(&source_first.expected_l, source_first.dt))
+                    .map(|(anchor, own)| anchor - own);
+                if let Some(with_exact_anchor) = error.zip(anchor_error).map(|(e, a)| e + a) {
+                    errors_with_exact_anchors.push(with_exact_anchor);
+                }
                 println!(
                     "{} <- {}: own start {} | plan at 10 % of the lane {} off | takeovers {} | \
-                     follower wait at {} lag {}",
+                     follower wait at {} lag {} | source anchor {} off",
                     spec.label(),
                     source_spec.speed_case.name,
                     f(own_start_s(&first.expected_l, first.dt)),
                     f(error),
                     target.summary.takeovers,
                     f(wait),
-                    f(lag)
+                    f(lag),
+                    f(anchor_error)
                 );
             }
         }
         other => return Err(format!("unknown mode `{other}`: `anchors` or `transfer`").into()),
     }
     println!("{}", spread(&mut errors));
+    if !errors_with_exact_anchors.is_empty() {
+        let spread = spread(&mut errors_with_exact_anchors);
+        println!("with the source's anchor at the driver's start: {spread}");
+    }
     Ok(())
 }
