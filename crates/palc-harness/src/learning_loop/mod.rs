@@ -35,6 +35,7 @@ use crate::driver::CarriedBelief;
 use crate::lesson::{lesson, scenes, zone_feature_set};
 use crate::method::Method;
 use crate::observer::{DriverEvidence, LessonEvent, Observer};
+use crate::onset::start_clear_of_vehicles_beside;
 use crate::personalization::{self, LessonPaths, Personalization};
 use crate::record::{ClosedLoopStats, FrozenEvaluation, LaneChangeRecord, Outcome, RunResult};
 use crate::refusal::Refusal;
@@ -629,6 +630,10 @@ impl LearningLoop {
         match result {
             Ok(mut outcome) => {
                 if let Some(start_s) = demonstration.start_s {
+                    // Nobody moves into a vehicle beside them
+                    // (docs/experiments/0097-no-start-beside-a-vehicle.md).
+                    let seen_moving_s = takeover_step as f64 * setup.dt;
+                    let start_s = start_clear_of_vehicles_beside(setup, start_s, seen_moving_s);
                     let experience = &mut outcome.experience;
                     learner
                         .personalization

@@ -16,7 +16,10 @@
 //! whole lane change from rest, its own shape ([`OwnShape`]) is fitted beside the
 //! models in later lessons. When neither explains what the user drove within a
 //! centimetre, the start is that of the onset's own power law fitted to the part
-//! of the onset seen (`power.rs`), when that law explains it.
+//! of the onset seen (`power.rs`), when that law explains it. A start fitted at
+//! a step where a target-lane vehicle is alongside moves to the first step from
+//! which none is, if the user was not yet seen moving there
+//! ([`start_clear_of_vehicles_beside`]): nobody moves into a vehicle beside them.
 //!
 //! The relative state at that start ([`Onset`]: time headway, time to collision
 //! and gap to the vehicle ahead, and a target-lane gap when it held the user back)
@@ -52,5 +55,6 @@ pub(crate) use fit::Shape;
 pub(crate) use fit::UserLaneChange;
 pub(crate) use own_shape::OwnShape;
 pub(crate) use prediction::{
-    onset_at, predicted_start_s, readings_explain, threshold_revealed_by_scenes,
+    onset_at, predicted_start_s, readings_explain, start_clear_of_vehicles_beside,
+    threshold_revealed_by_scenes,
 };

@@ -68,6 +68,40 @@ fn held_back(setup: &Setup, step: usize, gap: fn(&Situation) -> Option<f64>) -> 
     present_at_start && opened_now
 }
 
+/// Whether a target-lane vehicle is alongside the ego at `situation`: present,
+/// with a gap of at most 0.
+fn vehicle_beside(situation: &Situation) -> bool {
+    [lead_time_gap(situation), lag_time_gap(situation)]
+        .into_iter()
+        .flatten()
+        .any(|gap| gap <= 0.0)
+}
+
+/// The start of a lesson fitted at `start_s` (s), moved to the first step at
+/// which no target-lane vehicle is alongside when the fit placed it at a step
+/// where one is: nobody moves into a vehicle beside them, so the user started
+/// after it had passed, and the fit, which extrapolates the onset from what
+/// was seen after the takeover, placed the start too early. Never past
+/// `seen_moving_s`, the takeover, by which the user was seen moving: a
+/// vehicle alongside until then leaves the fit's start as it is.
+pub(crate) fn start_clear_of_vehicles_beside(
+    setup: &Setup,
+    start_s: f64,
+    seen_moving_s: f64,
+) -> f64 {
+    let Some(step) = start_step(setup, start_s) else {
+        return start_s;
+    };
+    if !vehicle_beside(&setup.situations[step]) {
+        return start_s;
+    }
+    (step..setup.situations.len())
+        .find(|&i| !vehicle_beside(&setup.situations[i]))
+        .map(|i| i as f64 * setup.dt)
+        .filter(|&clear| clear <= seen_moving_s)
+        .unwrap_or(start_s)
+}
+
 /// The relative state of `setup` revealed by the user's start at `start_s`, as an
 /// [`Onset`] of one observation: each feature's threshold between its values at
 /// the start's step and the step before ([`revealed`]), and what the user refused
@@ -661,6 +695,31 @@ mod tests {
             observations: 1,
             scene: None,
         }
+    }
+
+    #[test]
+    fn a_start_fitted_beside_a_vehicle_moves_to_where_it_has_passed_until_the_takeover() {
+        let text = include_str!("../../../../configs/learn.toml");
+        let config = crate::config::LearnConfig::from_toml_str(text).unwrap();
+        let mut setup = crate::scenario::prepare(&config).unwrap();
+        assert!(setup.situations.len() > 60);
+        // A follower alongside up to step 40, 5 m behind from step 41; no leader.
+        for (i, situation) in setup.situations.iter_mut().enumerate() {
+            situation.target_lead_gap_m = None;
+            situation.target_lag_gap_m = Some(if i <= 40 { -2.0 } else { 5.0 });
+            situation.target_lag_speed = Some(20.0);
+        }
+        let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
+        // Fitted at step 30, beside the follower, seen moving at 5 s: it started
+        // at step 41, once the follower had passed.
+        assert!(close(start_clear_of_vehicles_beside(&setup, 3.0, 5.0), 4.1));
+        // Seen moving at 4 s, while the follower was still beside: the fit stands.
+        assert!(close(start_clear_of_vehicles_beside(&setup, 3.0, 4.0), 3.0));
+        // A start fitted where nobody is beside stands.
+        assert!(close(
+            start_clear_of_vehicles_beside(&setup, 4.53, 5.0),
+            4.53
+        ));
     }
 
     #[test]
