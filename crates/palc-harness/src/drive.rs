@@ -389,9 +389,7 @@ fn entering(
 /// overlap (a gap of zero or less). A driver does not steer into a vehicle
 /// beside it.
 fn beside(scene: &Scene) -> bool {
-    let seen = situation(scene);
-    seen.target_lead_gap_m.is_some_and(|g| g <= 0.0)
-        || seen.target_lag_gap_m.is_some_and(|g| g <= 0.0)
+    situation(scene).target_vehicle_beside()
 }
 
 /// The first step at which `user`, driving its own expected lane change

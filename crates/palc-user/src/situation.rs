@@ -53,6 +53,14 @@ impl Situation {
         }
     }
 
+    /// Whether a target-lane vehicle is beside the ego: present, with a net gap
+    /// of zero or less (their lengths overlap). Nobody steers into a vehicle
+    /// beside them.
+    pub fn target_vehicle_beside(&self) -> bool {
+        self.target_lead_gap_m.is_some_and(|g| g <= 0.0)
+            || self.target_lag_gap_m.is_some_and(|g| g <= 0.0)
+    }
+
     /// The target lane's leader as `(net gap as a time gap at the ego's speed,
     /// time to collision)` (s); the time to collision is infinite when not closing.
     pub fn target_lead_times_s(&self) -> Option<(f64, f64)> {

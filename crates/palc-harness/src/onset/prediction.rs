@@ -68,15 +68,6 @@ fn held_back(setup: &Setup, step: usize, gap: fn(&Situation) -> Option<f64>) -> 
     present_at_start && opened_now
 }
 
-/// Whether a target-lane vehicle is alongside the ego at `situation`: present,
-/// with a gap of at most 0.
-fn vehicle_beside(situation: &Situation) -> bool {
-    [lead_time_gap(situation), lag_time_gap(situation)]
-        .into_iter()
-        .flatten()
-        .any(|gap| gap <= 0.0)
-}
-
 /// The start of a lesson fitted at `start_s` (s), moved to the first step at
 /// which no target-lane vehicle is alongside when the fit placed it at a step
 /// where one is: nobody moves into a vehicle beside them, so the user started
@@ -92,11 +83,11 @@ pub(crate) fn start_clear_of_vehicles_beside(
     let Some(step) = start_step(setup, start_s) else {
         return start_s;
     };
-    if !vehicle_beside(&setup.situations[step]) {
+    if !setup.situations[step].target_vehicle_beside() {
         return start_s;
     }
     (step..setup.situations.len())
-        .find(|&i| !vehicle_beside(&setup.situations[i]))
+        .find(|&i| !setup.situations[i].target_vehicle_beside())
         .map(|i| i as f64 * setup.dt)
         .filter(|&clear| clear <= seen_moving_s)
         .unwrap_or(start_s)
