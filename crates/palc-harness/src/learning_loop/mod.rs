@@ -632,8 +632,8 @@ impl LearningLoop {
                 if let Some(start_s) = demonstration.start_s {
                     // Nobody moves into a vehicle beside them
                     // (docs/experiments/0097-no-start-beside-a-vehicle.md).
-                    let seen_moving_s = takeover_step as f64 * setup.dt;
-                    let start_s = start_clear_of_vehicles_beside(setup, start_s, seen_moving_s);
+                    let takeover_s = takeover_step as f64 * setup.dt;
+                    let start_s = start_clear_of_vehicles_beside(setup, start_s, takeover_s);
                     let experience = &mut outcome.experience;
                     learner
                         .personalization

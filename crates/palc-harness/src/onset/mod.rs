@@ -18,7 +18,7 @@
 //! centimetre, the start is that of the onset's own power law fitted to the part
 //! of the onset seen (`power.rs`), when that law explains it. A start fitted at
 //! a step where a target-lane vehicle is alongside moves to the first step from
-//! which none is, if the user was not yet seen moving there
+//! which none is, if that step is not past the takeover
 //! ([`start_clear_of_vehicles_beside`]): nobody moves into a vehicle beside them.
 //!
 //! The relative state at that start ([`Onset`]: time headway, time to collision

@@ -73,13 +73,10 @@ fn held_back(setup: &Setup, step: usize, gap: fn(&Situation) -> Option<f64>) -> 
 /// where one is: nobody moves into a vehicle beside them, so the user started
 /// after it had passed, and the fit, which extrapolates the onset from what
 /// was seen after the takeover, placed the start too early. Never past
-/// `seen_moving_s`, the takeover, by which the user was seen moving: a
-/// vehicle alongside until then leaves the fit's start as it is.
-pub(crate) fn start_clear_of_vehicles_beside(
-    setup: &Setup,
-    start_s: f64,
-    seen_moving_s: f64,
-) -> f64 {
+/// `takeover_s`: a vehicle alongside until the takeover leaves the fit's start
+/// as it is, and a start after the takeover was seen (the fit holds it within
+/// the user's last step at rest and first moved one).
+pub(crate) fn start_clear_of_vehicles_beside(setup: &Setup, start_s: f64, takeover_s: f64) -> f64 {
     let Some(step) = start_step(setup, start_s) else {
         return start_s;
     };
@@ -89,7 +86,7 @@ pub(crate) fn start_clear_of_vehicles_beside(
     (step..setup.situations.len())
         .find(|&i| !setup.situations[i].target_vehicle_beside())
         .map(|i| i as f64 * setup.dt)
-        .filter(|&clear| clear <= seen_moving_s)
+        .filter(|&clear| clear <= takeover_s)
         .unwrap_or(start_s)
 }
 
@@ -701,10 +698,10 @@ mod tests {
             situation.target_lag_speed = Some(20.0);
         }
         let close = |a: f64, b: f64| (a - b).abs() < 1e-9;
-        // Fitted at step 30, beside the follower, seen moving at 5 s: it started
+        // Fitted at step 30, beside the follower, taken over at 5 s: it started
         // at step 41, once the follower had passed.
         assert!(close(start_clear_of_vehicles_beside(&setup, 3.0, 5.0), 4.1));
-        // Seen moving at 4 s, while the follower was still beside: the fit stands.
+        // Taken over at 4 s, while the follower was still beside: the fit stands.
         assert!(close(start_clear_of_vehicles_beside(&setup, 3.0, 4.0), 3.0));
         // A start fitted where nobody is beside stands.
         assert!(close(
