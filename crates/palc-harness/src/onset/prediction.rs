@@ -192,8 +192,18 @@ fn waited_for_the_follower(setup: &Setup, step: usize) -> bool {
 /// (docs/experiments/0045-what-the-user-refused.md). `None` when the follower was
 /// not alongside at the step before the start, or was alongside from the scene's
 /// first step.
+///
+/// The wait began when a target-lane vehicle first came alongside, as the leader
+/// or as the follower: a vehicle slower than the ego passes it backwards, beside
+/// it as the leader before it is beside it as the follower. Counting only the
+/// follower's part put the ceiling at a step with the leader alongside, where
+/// nobody starts (docs/experiments/0098-a-wait-that-began-beside-the-leader.md).
 fn last_open_step_before_alongside(setup: &Setup, step: usize) -> Option<usize> {
-    let alongside = |i: usize| lag_time_gap(&setup.situations[i]).is_some_and(|g| g <= 0.0);
+    let lag_alongside = |i: usize| lag_time_gap(&setup.situations[i]).is_some_and(|g| g <= 0.0);
+    if !step.checked_sub(1).is_some_and(lag_alongside) {
+        return None;
+    }
+    let alongside = |i: usize| setup.situations[i].target_vehicle_beside();
     let first_alongside = (0..step).rev().take_while(|&i| alongside(i)).last()?;
     let accepted = lead_time_gap(&setup.situations[step]).unwrap_or(f64::INFINITY);
     let lead = assumed_lead_gap_s(setup, accepted);
@@ -708,6 +718,41 @@ mod tests {
             start_clear_of_vehicles_beside(&setup, 4.53, 5.0),
             4.53
         ));
+    }
+
+    #[test]
+    fn a_wait_for_the_follower_began_when_it_came_alongside_as_the_leader() {
+        let text = include_str!("../../../../configs/learn.toml");
+        let config = crate::config::LearnConfig::from_toml_str(text).unwrap();
+        let mut setup = crate::scenario::prepare(&config).unwrap();
+        assert!(setup.situations.len() > 60);
+        // A slower target-lane vehicle passes the ego backwards: 40 m ahead up to
+        // step 10, 1 m ahead (too close to accept) up to 19, alongside as the
+        // leader from 20 to 39 and as the follower from 40 to 50, behind from 51.
+        for (i, situation) in setup.situations.iter_mut().enumerate() {
+            let (lead, lag) = match i {
+                0..=10 => (Some(40.0), None),
+                11..=19 => (Some(1.0), None),
+                20..=39 => (Some(-2.0), None),
+                40..=50 => (None, Some(-2.0)),
+                _ => (None, Some(3.0)),
+            };
+            (situation.target_lead_gap_m, situation.target_lag_gap_m) = (lead, lag);
+            situation.target_lead_speed = Some(20.0);
+            situation.target_lag_speed = Some(20.0);
+        }
+        // Started at step 51, when the follower had passed: the user could have
+        // started at step 10 at the latest, before the vehicle came alongside as
+        // the leader; not at 39, beside it.
+        assert_eq!(last_open_step_before_alongside(&setup, 51), Some(10));
+        // Never open before: the earliest start the wait allows is the step
+        // before the vehicle came alongside, whichever of the two it was then.
+        for situation in &mut setup.situations[..=10] {
+            situation.target_lead_gap_m = Some(1.0);
+        }
+        assert_eq!(last_open_step_before_alongside(&setup, 51), Some(19));
+        // A start the follower did not hold back has no such step.
+        assert_eq!(last_open_step_before_alongside(&setup, 30), None);
     }
 
     #[test]
