@@ -95,10 +95,11 @@ pub(crate) fn starting_experience(
             belief = estimated.belief;
             // Where two or more free starts reveal one threshold of a cue the
             // readings read, their interval places the start to the step; the
-            // estimate's predictive, with its 0.2 s observation error, does not.
+            // estimate's predictive, with its 0.2 s observation error, does not,
+            // unless it is sure of a cue the readings do not read (0089, 0099).
             let exact_readings = || threshold_revealed_by_scenes(&previous.onsets);
             (estimated.start_s)
-                .filter(|_| !(estimated.only_within_a_step && exact_readings()))
+                .filter(|_| estimated.on_another_cue || !exact_readings())
                 // Where no feature the readings read is consistent across the
                 // scenes, their own model does not explain them: the estimate's
                 // most probable start, however unsure (0095).

@@ -985,6 +985,7 @@ mod tests {
         let predicted = carried
             .start_s
             .expect("the scenes single the incentive out");
+        assert!(carried.on_another_cue);
         let dt = setups[target].dt;
         assert!(
             (predicted - expected).abs() < dt / 2.0,
@@ -1013,7 +1014,7 @@ mod tests {
         let dt = setups[target].dt;
         let carried = start_beyond_readings(&setups[target], before, 2.0);
         let predicted = carried.start_s.expect("sure of the start within a step");
-        assert!(carried.only_within_a_step);
+        assert!(!carried.on_another_cue);
         assert!(
             (predicted - last.time_s).abs() < dt / 2.0,
             "{predicted} against {}",

@@ -36,10 +36,12 @@
 //! posterior mass, when 95 % of the posterior lies on models the readings
 //! cannot represent (MOBIL's incentive, a reaction after the decision;
 //! docs/experiments/0073-a-drive-of-varied-scenes.md, 0079) or 95 % of the
-//! predictive within a step of that start (0080); the carry leaves the latter
-//! to the readings where two or more starts no gap held back reveal one
-//! threshold of a cue they read: their interval places the start to the step,
-//! which the estimate's 0.2 s observation error does not (0089). Where no
+//! predictive within a step of that start (0080); the carry leaves either to
+//! the readings where two or more starts no gap held back reveal one threshold
+//! of a cue they read: their interval places the start to the step, which the
+//! estimate's 0.2 s observation error does not (0089), and a reaction on that
+//! cue is then the prior's belief, not the scenes' (0099). Only 95 % on a cue
+//! they do not read keeps the estimate's start there. Where no
 //! feature the readings read is consistent across the free starts (their own
 //! model contradicted), the estimate's most probable start step predicts
 //! however unsure it is (0095).
@@ -104,11 +106,15 @@ pub(crate) struct CarriedEstimate {
     /// and for a driver outside the model or a scene the estimate says it does
     /// not start in.
     pub start_s: Option<f64>,
-    /// `start_s` rests on the posterior predictive alone (95 % within a step),
-    /// not on models the readings cannot represent: the carry then leaves the
-    /// start to the readings where the scenes reveal their threshold exactly
-    /// (`crate::carry`, docs/experiments/0089-the-thresholds-every-scene-allows.md).
-    pub only_within_a_step: bool,
+    /// `start_s` rests on [`CREDIBLE_MASS`] of the posterior on cues the
+    /// readings do not read. Otherwise the carry leaves the start to the
+    /// readings where the scenes reveal their threshold exactly
+    /// (`crate::carry`, docs/experiments/0089-the-thresholds-every-scene-allows.md):
+    /// a model of their cue without a reaction then places every start seen to
+    /// the step, and the estimate's belief in a reaction on that cue is its
+    /// prior's, which the scenes do not decide at its 0.2 s resolution
+    /// (docs/experiments/0099-a-reaction-the-scenes-do-not-show.md).
+    pub on_another_cue: bool,
     /// The start (s) of the step with the largest posterior predictive mass,
     /// however small that mass; the carry uses it where the readings' own
     /// model is contradicted (`crate::onset::readings_explain`). `None` below
@@ -144,7 +150,7 @@ pub(crate) fn start_beyond_readings(
     if estimate.outside_model() {
         return CarriedEstimate {
             start_s: None,
-            only_within_a_step: false,
+            on_another_cue: false,
             most_likely_s: None,
             belief,
         };
@@ -171,9 +177,10 @@ pub(crate) fn start_beyond_readings(
     let predicts = beyond || within_a_step >= CREDIBLE_MASS;
     let most_likely_s = (step < setup.situations.len()).then_some(step as f64 * setup.dt);
     let start_s = most_likely_s.filter(|_| predicts);
+    let another_cue = estimate.mass_where(|cue, _| !READ_BY_THE_READINGS.contains(&cue));
     CarriedEstimate {
         start_s,
-        only_within_a_step: start_s.is_some() && !beyond,
+        on_another_cue: start_s.is_some() && another_cue >= CREDIBLE_MASS,
         most_likely_s,
         belief,
     }
