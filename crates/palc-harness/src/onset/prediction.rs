@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use palc_aggregator::Onset;
+use palc_aggregator::{Onset, SceneSteps};
 
 use crate::setup::{Setup, target_gaps_safe};
 use palc_user::Situation;
@@ -474,21 +474,23 @@ fn revealed_interval(free: &[&Onset], feature: Decision) -> Option<(f64, f64)> {
     let value = |s: &Situation| feature.read_at(s);
     let (mut lowest, mut highest) = (f64::NEG_INFINITY, f64::INFINITY);
     for onset in free {
-        if onset.observations != 1 {
-            return None;
-        }
-        let scene = onset.scene.as_ref()?;
-        let step = (onset.time_s / scene.dt).round();
-        if !(step >= 1.0 && step < scene.steps.len() as f64) {
-            return None;
-        }
-        let step = step as usize;
+        let (scene, step) = start_in_scene(onset)?;
         lowest = lowest.max(value(&crate::driver::situation(&scene.steps[step]))?);
         if let Some(before) = value(&crate::driver::situation(&scene.steps[step - 1])) {
             highest = highest.min(before);
         }
     }
     (lowest < highest && highest.is_finite()).then_some((lowest, highest))
+}
+
+/// The scene `onset` recorded and the step of it at which the driver started;
+/// `None` without a scene, for a mean of several starts ([`Onset::merged`]: a
+/// mean of starts is not a step at which the driver started), and for a start
+/// at the scene's first step or past its end.
+fn start_in_scene(onset: &Onset) -> Option<(&SceneSteps, usize)> {
+    let scene = onset.scene.as_ref().filter(|_| onset.observations == 1)?;
+    let step = (onset.time_s / scene.dt).round();
+    (step >= 1.0 && step < scene.steps.len() as f64).then_some((scene, step as usize))
 }
 
 /// `onsets` with each start that was read as a wait for the follower
@@ -568,15 +570,7 @@ fn lag_acceptance(onsets: &[Onset]) -> f64 {
 fn waited_gap_interval(waits: &[&Onset]) -> Option<(f64, f64)> {
     let (mut lowest, mut highest) = (f64::NEG_INFINITY, f64::INFINITY);
     for onset in waits {
-        let scene = onset.scene.as_ref()?;
-        if onset.observations != 1 {
-            return None;
-        }
-        let step = (onset.time_s / scene.dt).round();
-        if !(step >= 1.0 && step < scene.steps.len() as f64) {
-            return None;
-        }
-        let step = step as usize;
+        let (scene, step) = start_in_scene(onset)?;
         let gap = |i: usize| lag_time_gap(&crate::driver::situation(&scene.steps[i]));
         lowest = lowest.max(gap(step - 1)?);
         highest = highest.min(gap(step)?);
@@ -726,7 +720,14 @@ fn decision_steps(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use palc_aggregator::{SceneSteps, SeenStep};
+    use palc_aggregator::SeenStep;
+
+    /// The scene of `configs/learn.toml`, whose target-lane vehicles a test sets.
+    fn learn_scene() -> Setup {
+        let text = include_str!("../../../../configs/learn.toml");
+        let config = crate::config::LearnConfig::from_toml_str(text).unwrap();
+        crate::scenario::prepare(&config).unwrap()
+    }
 
     fn onset(headway: f64, ttc: f64, lag: Option<f64>) -> Onset {
         Onset {
@@ -748,9 +749,7 @@ mod tests {
 
     #[test]
     fn a_start_fitted_beside_a_vehicle_moves_to_where_it_has_passed_until_the_takeover() {
-        let text = include_str!("../../../../configs/learn.toml");
-        let config = crate::config::LearnConfig::from_toml_str(text).unwrap();
-        let mut setup = crate::scenario::prepare(&config).unwrap();
+        let mut setup = learn_scene();
         assert!(setup.situations.len() > 60);
         // A follower alongside up to step 40, 5 m behind from step 41; no leader.
         for (i, situation) in setup.situations.iter_mut().enumerate() {
@@ -773,9 +772,7 @@ mod tests {
 
     #[test]
     fn a_wait_for_the_follower_began_when_it_came_alongside_as_the_leader() {
-        let text = include_str!("../../../../configs/learn.toml");
-        let config = crate::config::LearnConfig::from_toml_str(text).unwrap();
-        let mut setup = crate::scenario::prepare(&config).unwrap();
+        let mut setup = learn_scene();
         assert!(setup.situations.len() > 60);
         // A slower target-lane vehicle passes the ego backwards: 40 m ahead up to
         // step 10, 1 m ahead (too close to accept) up to 19, alongside as the
@@ -808,9 +805,7 @@ mod tests {
 
     #[test]
     fn waits_for_the_follower_need_the_middle_of_the_gaps_every_scene_allows() {
-        let text = include_str!("../../../../configs/learn.toml");
-        let config = crate::config::LearnConfig::from_toml_str(text).unwrap();
-        let base = crate::scenario::prepare(&config).unwrap();
+        let base = learn_scene();
         assert!(base.situations.len() > 30);
         // A follower whose time gap opens by `rate` s a step from `offset` s; a
         // user who needs 0.5 s starts at the first step at which it has it.
@@ -854,9 +849,7 @@ mod tests {
 
     #[test]
     fn a_refused_lead_gap_above_an_accepted_one_asks_no_more_than_the_accepted_one() {
-        let text = include_str!("../../../../configs/learn.toml");
-        let config = crate::config::LearnConfig::from_toml_str(text).unwrap();
-        let setup = crate::scenario::prepare(&config).unwrap();
+        let setup = learn_scene();
         // The lead gaps this scene offers over its steps: a refused gap between
         // two of them moves the start when it is the need, and must not here.
         let gaps: Vec<f64> = setup.situations.iter().filter_map(lead_time_gap).collect();
