@@ -33,7 +33,8 @@
 //! refused after the decision (a scene's onset learned with earlier scenes'
 //! decision threshold) bounds the lead gap the user needs from below, the largest
 //! rejected gap of gap-acceptance models; and when every onset was held back by
-//! a follower alongside, the headway just before that follower arrived bounds the
+//! a follower alongside, the headway just before a vehicle first came alongside
+//! (the leader of a vehicle passing backwards, or the follower) bounds the
 //! decision from above (the user had not started there). The decision is then
 //! known within an interval and nothing in the scene prefers one threshold of it
 //! to another; the start predicted is the one that most of the interval leads to
@@ -41,7 +42,8 @@
 //! that part starts at one step). A start at a headway below the standard ALC's
 //! decision headway, with the follower's gap opening into it, is read as a wait
 //! for that gap (every user decides before the standard ALC does: the paper's
-//! premise). A lead gap the user accepted bounds the one it needs from above;
+//! premise); two or more such waits need the middle of the follower's gaps all
+//! their scenes allow. A lead gap the user accepted bounds the one it needs from above;
 //! until it has accepted one smaller than the standard ALC's requirement, that
 //! requirement is assumed (the system's own, not fitted to any user).
 

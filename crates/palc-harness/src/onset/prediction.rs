@@ -547,17 +547,18 @@ fn acceptance(onsets: &[Onset], gap: fn(&Onset) -> Option<f64>) -> f64 {
 /// docs/experiments/0100-the-follower-gap-every-wait-allows.md). With one wait,
 /// or intervals that do not meet, each wait's own midpoint stands.
 fn lag_acceptance(onsets: &[Onset]) -> f64 {
+    let waited = |o: &Onset| o.follower_wait_time_headway_s.is_some();
     let waits: Vec<&Onset> = (onsets.iter())
-        .filter(|o| o.follower_wait_time_headway_s.is_some() && o.lag_time_gap_s.is_some())
+        .filter(|o| waited(o) && o.lag_time_gap_s.is_some())
         .collect();
     let revealed = (waits.len() >= 2)
         .then(|| waited_gap_interval(&waits))
         .flatten()
         .map(|(lowest, highest)| 0.5 * (lowest + highest));
     (onsets.iter())
-        .filter_map(|o| match (o.follower_wait_time_headway_s, revealed) {
-            (Some(_), Some(middle)) if o.lag_time_gap_s.is_some() => Some(middle),
-            _ => o.lag_time_gap_s,
+        .filter_map(|o| {
+            o.lag_time_gap_s
+                .map(|g| revealed.filter(|_| waited(o)).unwrap_or(g))
         })
         .reduce(f64::min)
         .map_or(0.0, |g| g.max(0.0))
