@@ -12,9 +12,7 @@ use palc_planner::{Planner, Problem, State, Weights};
 use crate::HarnessError;
 use crate::driver::{CarriedBelief, start_beyond_readings};
 use crate::lesson::scenes;
-use crate::onset::{
-    UserLaneChange, predicted_start_s, readings_explain, threshold_revealed_by_scenes,
-};
+use crate::onset::{GapAcceptanceSet, UserLaneChange};
 use crate::setup::Setup;
 
 /// Who and where an experience is learned: the names it is saved with.
@@ -47,8 +45,8 @@ pub struct Carried {
 /// The weights are resampled to this scenario's horizon and step. When `relative`
 /// (experience in relative space) and a user's start was observed before, they are
 /// also shifted so that the learned start falls where this scene predicts the
-/// relative state the user started in ([`predicted_start_s`]), held no later than
-/// [`latest_planned_start_s`]; the last lesson's path is shifted alike and returned
+/// relative state the user started in ([`GapAcceptanceSet::predicted_start_s`]),
+/// held no later than [`latest_planned_start_s`]; the last lesson's path is shifted alike and returned
 /// for [`rehearse`]. Without an observed start, or when none is predicted here, the
 /// weights keep their time base.
 ///
@@ -94,19 +92,22 @@ pub(crate) fn starting_experience(
             let estimated = start_beyond_readings(setup, &previous.onsets, lane_change);
             belief = estimated.belief;
             // Where two or more free starts reveal one threshold of a cue the
-            // readings read, their interval places the start to the step; the
-            // estimate's predictive, with its 0.2 s observation error, does not,
-            // unless it is sure of a cue the readings do not read (0089, 0099).
-            let exact_readings = || threshold_revealed_by_scenes(&previous.onsets);
+            // gap-acceptance set reads, its interval places the start to the
+            // step; the estimate's predictive, with its 0.2 s observation error,
+            // does not, unless it is sure of a cue the set does not read (0089,
+            // 0099).
+            let set = GapAcceptanceSet::from_onsets(&previous.onsets);
+            let exact = set.as_ref().is_some_and(GapAcceptanceSet::revealed_exactly);
             (estimated.start_s)
-                .filter(|_| estimated.on_another_cue || !exact_readings())
-                // Where no feature the readings read is consistent across the
-                // scenes, their own model does not explain them: the estimate's
-                // most probable start, however unsure (0095).
+                .filter(|_| estimated.on_another_cue || !exact)
+                // Where no cue the set reads is consistent across the scenes, its
+                // model does not explain them: the estimate's most probable
+                // start, however unsure (0095).
                 .or_else(|| {
-                    (estimated.most_likely_s).filter(|_| !readings_explain(&previous.onsets))
+                    let unexplained = set.as_ref().is_some_and(|set| !set.explains());
+                    (estimated.most_likely_s).filter(|_| unexplained)
                 })
-                .or_else(|| predicted_start_s(setup, &previous.onsets, lane_change))
+                .or_else(|| set.as_ref()?.predicted_start_s(setup, lane_change))
                 .map(|start| (anchor, start.min(latest)))
         }
         _ => None,

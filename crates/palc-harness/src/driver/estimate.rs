@@ -1020,9 +1020,10 @@ mod tests {
             "{predicted} against {}",
             last.time_s
         );
-        assert!(crate::onset::threshold_revealed_by_scenes(before));
-        let predicted = crate::onset::predicted_start_s(&setups[target], before, 2.0)
-            .expect("the readings predict a start");
+        let set = crate::onset::GapAcceptanceSet::from_onsets(before).unwrap();
+        assert!(set.revealed_exactly());
+        let predicted =
+            (set.predicted_start_s(&setups[target], 2.0)).expect("the set predicts a start");
         assert!(
             (predicted - last.time_s).abs() < dt / 2.0,
             "{predicted} against {}",

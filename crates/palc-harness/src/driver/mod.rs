@@ -60,10 +60,11 @@ use serde::{Deserialize, Serialize};
 use crate::setup::Setup;
 use prior::Cue;
 
-/// The cues the onsets' readings read (`crate::onset::predicted_start_s`). The
+/// The cues the onsets' readings read (`crate::onset::GapAcceptanceSet`). The
 /// readings read the decision at the start itself: a driver who starts a
 /// reaction after deciding is a model they cannot represent either.
-const READ_BY_THE_READINGS: [Cue; 3] = [Cue::TimeHeadway, Cue::TimeToCollision, Cue::DistanceGap];
+pub(crate) const READ_BY_THE_READINGS: [Cue; 3] =
+    [Cue::TimeHeadway, Cue::TimeToCollision, Cue::DistanceGap];
 
 /// The usual 95 % credibility, asked of the estimate before it predicts a
 /// carried start in place of the readings: either of the posterior on models

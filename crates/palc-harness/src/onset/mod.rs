@@ -3,7 +3,7 @@
 //! docs/experiments/0043-predicting-the-start.md).
 //!
 //! A takeover shows the user's own lateral profile from the takeover on. Its start
-//! is found by fitting a lane-change model through two crossings of it ([`Shape`]):
+//! is found by fitting a lane-change model through two crossings of it ([`Shape`](fit::Shape)):
 //! the paper's quintic or a half-sine lateral speed, each symmetric or skewed (its
 //! lateral speed peaking earlier or later than mid-move), keeping the model closest
 //! to the profile up to the upper crossing. With `x(p)` the inverse of the model's
@@ -21,13 +21,17 @@
 //! which none is, if that step is not past the takeover
 //! ([`start_clear_of_vehicles_beside`]): nobody moves into a vehicle beside them.
 //!
-//! The relative state at that start ([`Onset`]: time headway, time to collision
-//! and gap to the vehicle ahead, and a target-lane gap when it held the user back)
-//! is what carries, recorded with what the user saw at every step of the scene
-//! (what the driver estimate of `crate::driver` reads). In a new scene the start is predicted with the structure of a
-//! gap-acceptance driver: the user decides when the decision feature falls to
-//! the learned threshold, then starts at the first step from there where the
-//! target-lane gaps are at least the learned ones ([`predicted_start_s`]).
+//! The relative state at that start ([`Onset`](palc_aggregator::Onset): time
+//! headway, time to collision and gap to the vehicle ahead, and a target-lane
+//! gap when it held the user back) is what carries, recorded with what the user
+//! saw at every step of the scene (`observed.rs`; what the driver estimate of
+//! `crate::driver` reads). In a new scene the start is predicted with the
+//! structure of a gap-acceptance driver: the user decides when one cue of the
+//! vehicle ahead (`cues.rs`) falls to its threshold, then starts at the first
+//! step from there where the target-lane gaps are at least the ones it needs.
+//! [`GapAcceptanceSet`] keeps what every onset allows of that model, and its
+//! start is the one most of the set leads to in the new scene
+//! ([`GapAcceptanceSet::predicted_start_s`]).
 //!
 //! What one scene cannot show is bounded from what the user refused: a lead gap
 //! refused after the decision (a scene's onset learned with earlier scenes'
@@ -35,28 +39,27 @@
 //! rejected gap of gap-acceptance models; and when every onset was held back by
 //! a follower alongside, the headway just before a vehicle first came alongside
 //! (the leader of a vehicle passing backwards, or the follower) bounds the
-//! decision from above (the user had not started there). The decision is then
-//! known within an interval and nothing in the scene prefers one threshold of it
-//! to another; the start predicted is the one that most of the interval leads to
-//! in the new scene (where a follower holds back every threshold of a part of it,
-//! that part starts at one step). A start at a headway below the standard ALC's
-//! decision headway, with the follower's gap opening into it, is read as a wait
-//! for that gap (every user decides before the standard ALC does: the paper's
-//! premise); two or more such waits need the middle of the follower's gaps all
-//! their scenes allow. A lead gap the user accepted bounds the one it needs from above;
-//! until it has accepted one smaller than the standard ALC's requirement, that
-//! requirement is assumed (the system's own, not fitted to any user).
+//! decision from above (the user had not started there). A start at a headway
+//! below the standard ALC's decision headway, with the follower's gap opening
+//! into it, is read as a wait for that gap (every user decides before the
+//! standard ALC does: the paper's premise); two or more such waits need the
+//! middle of the follower's gaps all their scenes allow. A lead gap the user
+//! accepted bounds the one it needs from above; until it has accepted one
+//! smaller than the standard ALC's requirement, that requirement is assumed (the
+//! system's own, not fitted to any user).
 
+mod cues;
 mod fit;
+mod gap_acceptance;
+mod observed;
 mod own_shape;
 mod power;
-mod prediction;
+#[cfg(test)]
+mod test_scenes;
 
 #[cfg(test)]
 pub(crate) use fit::Shape;
 pub(crate) use fit::UserLaneChange;
+pub(crate) use gap_acceptance::GapAcceptanceSet;
+pub(crate) use observed::{onset_at, start_clear_of_vehicles_beside};
 pub(crate) use own_shape::OwnShape;
-pub(crate) use prediction::{
-    onset_at, predicted_start_s, readings_explain, start_clear_of_vehicles_beside,
-    threshold_revealed_by_scenes,
-};

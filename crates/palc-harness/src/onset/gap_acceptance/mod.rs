@@ -1,0 +1,145 @@
+//! What the onsets of a user's lessons allow of a gap-acceptance driver
+//! ([`GapAcceptanceSet`]), and the start they predict in a new scene
+//! ([`GapAcceptanceSet::predicted_start_s`]).
+//!
+//! The model is the one the paper's user follows: the driver decides when one
+//! cue of the vehicle ahead (time headway, time to collision or gap,
+//! [`Cue`](crate::driver::prior::Cue)) has fallen to a threshold, then starts
+//! at the first step from there at which the target lane's leader and follower
+//! are at least the time gaps it needs. Each onset is an observation of that
+//! model in its scene, and the set keeps what every observation allows
+//! (set membership, not a best fit):
+//!
+//! - the cue and the interval of its threshold (`decision.rs`): a free start at
+//!   step `k` allows `θ ∈ [x(k), x(k − 1))`, and scenes together their
+//!   intersection; a start a target-lane gap held back bounds the threshold from
+//!   below, and the last step at which it could have started before that wait
+//!   (its ceiling) from above;
+//! - the gaps (`gaps.rs`): the leader's gap the driver needs, from below by
+//!   every gap that held it back or that it refused after deciding, from above by
+//!   the smallest it accepted; the follower's gap, from the waits for it.
+//!
+//! Where the scenes leave an interval, the start predicted is the one most of it
+//! leads to in the new scene (`start.rs`): a uniform belief over what the
+//! scenes allow, not a choice of one end. Where no cue is consistent across the
+//! scenes the model does not explain them ([`GapAcceptanceSet::explains`]) and
+//! the driver estimate (`crate::driver`) predicts instead.
+
+mod decision;
+mod gaps;
+mod start;
+
+use palc_aggregator::{Onset, SceneSteps};
+
+pub(crate) use decision::decision;
+pub(crate) use gaps::assumed_lead_gap_s;
+
+use decision::{DecisionRange, decision_range};
+use gaps::{acceptance, lag_acceptance};
+
+/// The gap-acceptance drivers a user's onsets allow: the cue it decides on with
+/// the interval of its threshold, and the target-lane gaps it needs.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct GapAcceptanceSet {
+    /// The cue and the thresholds of it the onsets allow.
+    decision: DecisionRange,
+    /// The leader's time gap (s) the driver needs at least: the smallest that
+    /// held it back, or the largest it refused after deciding, but no more than
+    /// the smallest it accepted.
+    lead_at_least_s: f64,
+    /// The smallest leader's time gap (s) the driver accepted; infinite for none.
+    smallest_accepted_lead_s: f64,
+    /// The follower's time gap (s) the driver needs.
+    lag_s: f64,
+}
+
+impl GapAcceptanceSet {
+    /// What `onsets` allow; `None` without onsets.
+    pub(crate) fn from_onsets(onsets: &[Onset]) -> Option<Self> {
+        if onsets.is_empty() {
+            return None;
+        }
+        // A lead gap the user refused after deciding is below the one it needs.
+        let refused = (onsets.iter())
+            .filter_map(|o| o.rejected_lead_time_gap_s)
+            .fold(0.0, f64::max);
+        let accepted = (onsets.iter())
+            .filter_map(|o| o.accepted_lead_time_gap_s)
+            .reduce(f64::min)
+            .unwrap_or(f64::INFINITY);
+        // A refused gap is read through the learned threshold (the user had
+        // decided, so only the leader can have held it back), an accepted one is
+        // seen: a driver who accepted a gap does not need a larger one, so a
+        // refused gap above an accepted one was a misreading (the decision came
+        // later than the threshold said) and bounds the need by the accepted gap
+        // at most (docs/experiments/0073-a-drive-of-varied-scenes.md).
+        let refused = refused.min(accepted);
+        Some(GapAcceptanceSet {
+            decision: decision_range(onsets),
+            lead_at_least_s: acceptance(onsets, |o| o.lead_time_gap_s).max(refused),
+            smallest_accepted_lead_s: accepted,
+            lag_s: lag_acceptance(onsets),
+        })
+    }
+
+    /// Whether the threshold predicted with is one that the scenes of at least
+    /// two free onsets reveal exactly (`decision::revealed_interval`): every
+    /// start is a threshold of one cue crossed at a step, as a driver who
+    /// decides on that cue starts. The driver estimate, whose observation error
+    /// is [`OBSERVATION_SD_S`](crate::driver::prior::OBSERVATION_SD_S) (0.2 s,
+    /// two steps, for starts read from noisy paths), does not place such a start
+    /// to the step; the interval does.
+    pub(crate) fn revealed_exactly(&self) -> bool {
+        self.decision.revealed_by >= 2
+    }
+
+    /// Whether the model explains the onsets (`DecisionRange::explained`): where
+    /// no cue is consistent across the scenes, the set falls back to the time
+    /// headway, which the scenes contradict
+    /// (docs/experiments/0095-a-wait-weighed-by-the-prior-and-readings-that-contradict-themselves.md).
+    pub(crate) fn explains(&self) -> bool {
+        self.decision.explained
+    }
+}
+
+/// The scene `onset` recorded and the step of it at which the driver started;
+/// `None` without a scene, for a mean of several starts ([`Onset::merged`]: a
+/// mean of starts is not a step at which the driver started), and for a start
+/// at the scene's first step or past its end.
+fn start_in_scene(onset: &Onset) -> Option<(&SceneSteps, usize)> {
+    let scene = onset.scene.as_ref().filter(|_| onset.observations == 1)?;
+    let step = (onset.time_s / scene.dt).round();
+    (step >= 1.0 && step < scene.steps.len() as f64).then_some((scene, step as usize))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::GapAcceptanceSet;
+    use crate::onset::test_scenes::onset;
+
+    fn explains(onsets: &[palc_aggregator::Onset]) -> bool {
+        GapAcceptanceSet::from_onsets(onsets).unwrap().explains()
+    }
+
+    #[test]
+    fn no_onset_allows_no_set() {
+        assert_eq!(GapAcceptanceSet::from_onsets(&[]), None);
+    }
+
+    #[test]
+    fn the_model_explains_its_onsets_while_one_cue_is_consistent() {
+        // One scene, or scenes that agree on the headway or on another feature.
+        assert!(explains(&[onset(1.2, 10.0, None)]));
+        assert!(explains(&[onset(1.2, 10.0, None), onset(1.21, 5.0, None)]));
+        assert!(explains(&[onset(1.6, 8.0, None), onset(0.8, 8.1, None)]));
+        // No feature agrees across the two scenes: the headway (and the gap,
+        // twenty metres a second of it here) a third apart, the time to
+        // collision half.
+        assert!(!explains(&[onset(1.2, 10.0, None), onset(0.8, 5.0, None)]));
+        // A held-back start says nothing about consistency of free ones.
+        assert!(explains(&[
+            onset(1.2, 10.0, None),
+            onset(0.8, 5.0, Some(0.2))
+        ]));
+    }
+}
