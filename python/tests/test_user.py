@@ -55,6 +55,13 @@ def test_the_loop_says_what_it_believes_about_the_driver_after_a_lesson() -> Non
     belief = learning.driver_estimate()
     assert belief is not None and "decides on the time-headway" in belief, belief
     assert "scenes seen: 1" in belief
+    allowed = learning.gap_acceptance()
+    assert allowed is not None and "decides on the time-headway at" in allowed, allowed
+    assert "follower's gap of" in allowed
+
+
+def test_no_start_allows_no_gap_acceptance_driver() -> None:
+    assert palc.LearningLoop(config()).gap_acceptance() is None
 
 
 def test_result_runs_a_loop_to_its_end() -> None:

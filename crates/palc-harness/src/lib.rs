@@ -83,6 +83,7 @@ pub mod advanced {
     pub use crate::carry::{Carried, Names};
     pub use crate::drive::{Drive, execute, execute_in, judge, plan_safety, problem};
     pub use crate::method::{Driver, label};
+    pub use crate::onset::GapAcceptanceSet;
     pub use crate::personalization::{
         Demonstration, LessonPaths, Personalization, RelativeOnset, Replay, SceneAveraged,
         for_options,

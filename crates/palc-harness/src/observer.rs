@@ -5,6 +5,7 @@
 use palc_aggregator::{AggregatorError, Lesson, Onset, StepOutcome};
 
 use crate::driver::DriverEstimate;
+use crate::onset::GapAcceptanceSet;
 
 use crate::record::{LaneChangeRecord, RunSummary};
 use crate::safety::Violation;
@@ -60,6 +61,13 @@ impl DriverEvidence<'_> {
     pub fn estimate(&self) -> Option<DriverEstimate> {
         DriverEstimate::from_onsets(self.onsets, self.lane_change_duration_s)
     }
+
+    /// The gap-acceptance drivers these observations allow, from which a start
+    /// on the cues it reads is carried ([`GapAcceptanceSet`]); `None` before any
+    /// onset.
+    pub fn gap_acceptance(&self) -> Option<GapAcceptanceSet> {
+        GapAcceptanceSet::from_onsets(self.onsets)
+    }
 }
 
 impl LessonEvent<'_> {
@@ -79,6 +87,16 @@ impl LessonEvent<'_> {
         match self {
             LessonEvent::Learned { driver, .. } | LessonEvent::Failed { driver, .. } => {
                 driver.estimate()
+            }
+        }
+    }
+
+    /// The gap-acceptance drivers the onsets allow after this lesson
+    /// ([`GapAcceptanceSet`]); `None` before any onset. Computed on each call.
+    pub fn gap_acceptance(&self) -> Option<GapAcceptanceSet> {
+        match self {
+            LessonEvent::Learned { driver, .. } | LessonEvent::Failed { driver, .. } => {
+                driver.gap_acceptance()
             }
         }
     }

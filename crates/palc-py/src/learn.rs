@@ -11,6 +11,7 @@ use std::path::PathBuf;
 use std::sync::Mutex;
 
 use palc_aggregator::Experience as RustExperience;
+use palc_harness::advanced::GapAcceptanceSet;
 use palc_harness::driver::DriverEstimate;
 use palc_harness::{HarnessError, LaneChangeRecord, NoObserver, RunResult};
 use pyo3::prelude::*;
@@ -482,6 +483,19 @@ impl LearningLoop {
                 let duration_s = learning.setup().standard_alc.lane_change_duration_s;
                 DriverEstimate::from_onsets(&learning.experience().onsets, duration_s)
                     .map(|estimate| estimate.describe())
+            }))
+        })
+    }
+
+    /// The gap-acceptance drivers the starts so far allow, in one line: the cue, its
+    /// threshold (or the interval waits bound it to) and the gaps to the target lane's
+    /// leader and follower; the start carried into a new scene for the cues it reads is
+    /// the one most of them lead to. ``None`` before a start was recorded.
+    fn gap_acceptance(&self, py: Python<'_>) -> PyResult<Option<String>> {
+        self.with(py, |slot| {
+            Ok(slot.as_ref().and_then(|learning| {
+                GapAcceptanceSet::from_onsets(&learning.experience().onsets)
+                    .map(|set| set.describe())
             }))
         })
     }

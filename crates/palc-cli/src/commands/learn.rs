@@ -150,6 +150,12 @@ impl Observer for Printer {
                 estimate.describe()
             );
         }
+        if let Some(set) = event.gap_acceptance() {
+            say!(
+                "               the starts allow a driver who {}",
+                set.describe()
+            );
+        }
     }
 
     fn finished(&mut self, summary: &RunSummary) {

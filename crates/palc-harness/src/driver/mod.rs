@@ -28,8 +28,10 @@
 //! keeps what the estimate believed when its experience was carried in
 //! ([`CarriedBelief`], in `RunResult::carried_belief`); the evaluation counts the
 //! misfits per user kind. The start carried into a new scene is predicted by
-//! the onsets' readings (`crate::onset`), which read the time headway, the time
-//! to collision and the distance gap at the start itself; as the predictor for
+//! the onsets' readings (`crate::onset`'s `GapAcceptanceSet`, a set-membership
+//! estimate of a gap-acceptance driver without a reaction), which read the time
+//! headway, the time to collision and the distance gap at the start itself; as
+//! the predictor for
 //! those cues the estimate's most probable model cost more takeovers on the
 //! evaluation's grid (docs/experiments/0068-one-driver-model.md). The estimate
 //! predicts instead (`start_beyond_readings`): the start step with the largest
@@ -70,9 +72,10 @@ pub(crate) const READ_BY_THE_READINGS: [Cue; 3] =
 /// carried start in place of the readings: either of the posterior on models
 /// the readings cannot represent (a cue they do not read, or a reaction), or of
 /// the posterior predictive on the predicted start step and its two neighbours
-/// (the estimate is sure of the start within a step, whatever the model). One scene never gives it when
-/// another cue explains the same start with a longer reaction (a reaction user's
-/// start, read as an incentive decision, cost it takeovers at a majority of 50 %).
+/// (the estimate is sure of the start within a step, whatever the model). One
+/// scene never gives it when another cue explains the same start with a longer
+/// reaction (a reaction user's start, read as an incentive decision, cost it
+/// takeovers at a majority of 50 %).
 const CREDIBLE_MASS: f64 = 0.95;
 
 /// The scenes the estimate must have seen before it predicts: one scene is

@@ -60,6 +60,6 @@ mod test_scenes;
 #[cfg(test)]
 pub(crate) use fit::Shape;
 pub(crate) use fit::UserLaneChange;
-pub(crate) use gap_acceptance::GapAcceptanceSet;
+pub use gap_acceptance::GapAcceptanceSet;
 pub(crate) use observed::{onset_at, start_clear_of_vehicles_beside};
 pub(crate) use own_shape::OwnShape;

@@ -177,8 +177,9 @@ fn waited_for_the_follower(setup: &Setup, step: usize) -> bool {
 /// the prediction weighs
 /// ([`GapAcceptanceSet::predicted_start_s`](super::GapAcceptanceSet::predicted_start_s)).
 /// Without a ceiling the decision kept only its lower bound, the latest start
-/// the wait allows; with the fallback the transfer matrix's pairs need 190 takeovers instead of 197 (deterministic users), and
-/// fewer or as many for every start rule
+/// the wait allows; with the fallback the transfer matrix's pairs need 190
+/// takeovers instead of 197 (deterministic users), and fewer or as many for
+/// every start rule
 /// (docs/experiments/0045-what-the-user-refused.md). `None` when the follower was
 /// not alongside at the step before the start, or was alongside from the scene's
 /// first step.

@@ -31,6 +31,8 @@ mod start;
 
 use palc_aggregator::{Onset, SceneSteps};
 
+use crate::driver::prior::Cue;
+
 pub(crate) use decision::decision;
 pub(crate) use gaps::assumed_lead_gap_s;
 
@@ -38,9 +40,11 @@ use decision::{DecisionRange, decision_range};
 use gaps::{acceptance, lag_acceptance};
 
 /// The gap-acceptance drivers a user's onsets allow: the cue it decides on with
-/// the interval of its threshold, and the target-lane gaps it needs.
+/// the interval of its threshold, and the target-lane gaps it needs. What the
+/// carry predicts a start from for the cues it reads (`crate::carry`), printed
+/// by `palc learn` after every lesson ([`crate::DriverEvidence::gap_acceptance`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct GapAcceptanceSet {
+pub struct GapAcceptanceSet {
     /// The cue and the thresholds of it the onsets allow.
     decision: DecisionRange,
     /// The leader's time gap (s) the driver needs at least: the smallest that
@@ -55,7 +59,7 @@ pub(crate) struct GapAcceptanceSet {
 
 impl GapAcceptanceSet {
     /// What `onsets` allow; `None` without onsets.
-    pub(crate) fn from_onsets(onsets: &[Onset]) -> Option<Self> {
+    pub fn from_onsets(onsets: &[Onset]) -> Option<Self> {
         if onsets.is_empty() {
             return None;
         }
@@ -89,7 +93,7 @@ impl GapAcceptanceSet {
     /// is [`OBSERVATION_SD_S`](crate::driver::prior::OBSERVATION_SD_S) (0.2 s,
     /// two steps, for starts read from noisy paths), does not place such a start
     /// to the step; the interval does.
-    pub(crate) fn revealed_exactly(&self) -> bool {
+    pub fn revealed_exactly(&self) -> bool {
         self.decision.revealed_by >= 2
     }
 
@@ -97,8 +101,82 @@ impl GapAcceptanceSet {
     /// no cue is consistent across the scenes, the set falls back to the time
     /// headway, which the scenes contradict
     /// (docs/experiments/0095-a-wait-weighed-by-the-prior-and-readings-that-contradict-themselves.md).
-    pub(crate) fn explains(&self) -> bool {
+    pub fn explains(&self) -> bool {
         self.decision.explained
+    }
+
+    /// The cue the driver is believed to decide on.
+    pub fn cue(&self) -> Cue {
+        self.decision.feature
+    }
+
+    /// The thresholds of [`GapAcceptanceSet::cue`] the onsets allow, `(lowest,
+    /// highest)`, in the cue's unit (s, or m for the distance gap); the two are
+    /// equal where one threshold stands for the set (the middle of an interval
+    /// the scenes revealed, or the largest start value seen). For the time
+    /// headway the prediction also holds the lowest at the standard ALC's
+    /// decision headway (the paper's premise).
+    pub fn thresholds(&self) -> (f64, f64) {
+        (self.decision.lowest, self.decision.highest)
+    }
+
+    /// The leader's time gap (s) the driver needs at least, from what held it
+    /// back and what it refused; the prediction also assumes the standard ALC's
+    /// until the driver accepted a smaller one.
+    pub fn lead_gap_at_least_s(&self) -> f64 {
+        self.lead_at_least_s
+    }
+
+    /// The smallest leader's time gap (s) the driver accepted; `None` for none.
+    pub fn smallest_accepted_lead_gap_s(&self) -> Option<f64> {
+        Some(self.smallest_accepted_lead_s).filter(|g| g.is_finite())
+    }
+
+    /// The follower's time gap (s) the driver needs (0 when no follower held it
+    /// back: a follower alongside is never accepted).
+    pub fn lag_gap_s(&self) -> f64 {
+        self.lag_s
+    }
+
+    /// One line for a reader: the cue, its thresholds, how the scenes pinned
+    /// them, and the gaps.
+    pub fn describe(&self) -> String {
+        let unit = if self.cue() == Cue::DistanceGap {
+            "m"
+        } else {
+            "s"
+        };
+        let (lowest, highest) = self.thresholds();
+        let thresholds = if lowest < highest {
+            format!("from {lowest:.2} to {highest:.2} {unit} (waits bound it)")
+        } else if self.revealed_exactly() {
+            format!(
+                "at {highest:.2} {unit} (the middle of what {} starts allow)",
+                self.decision.revealed_by
+            )
+        } else {
+            format!("at {highest:.2} {unit}")
+        };
+        // The leader's gap needed lies between what held the driver back or it
+        // refused and the smallest it accepted.
+        let lead = match self.smallest_accepted_lead_gap_s() {
+            Some(accepted) => format!(
+                "between {:.2} and {accepted:.2} s",
+                self.lead_gap_at_least_s()
+            ),
+            None => format!("of {:.2} s or more", self.lead_gap_at_least_s()),
+        };
+        let unexplained = if self.explains() {
+            ""
+        } else {
+            "; no cue agrees across the scenes, so the estimate predicts"
+        };
+        format!(
+            "decides on the {} {thresholds}, needs a leader's gap {lead} and a \
+             follower's gap of {:.2} s{unexplained}",
+            self.cue().name(),
+            self.lag_gap_s(),
+        )
     }
 }
 
@@ -115,7 +193,8 @@ fn start_in_scene(onset: &Onset) -> Option<(&SceneSteps, usize)> {
 #[cfg(test)]
 mod tests {
     use super::GapAcceptanceSet;
-    use crate::onset::test_scenes::onset;
+    use crate::driver::prior::Cue;
+    use crate::onset::test_scenes::{onset, onset_of_a_closing_scene};
 
     fn explains(onsets: &[palc_aggregator::Onset]) -> bool {
         GapAcceptanceSet::from_onsets(onsets).unwrap().explains()
@@ -141,5 +220,43 @@ mod tests {
             onset(1.2, 10.0, None),
             onset(0.8, 5.0, Some(0.2))
         ]));
+    }
+
+    #[test]
+    fn the_set_says_what_it_allows() {
+        // Two free starts of a driver at 1.2 s in scenes closing at different
+        // rates: their intervals meet around the threshold.
+        let (slow, fast) = (
+            onset_of_a_closing_scene(20.0, 1.0, 1.2),
+            onset_of_a_closing_scene(25.0, 3.0, 1.2),
+        );
+        let set = GapAcceptanceSet::from_onsets(&[slow, fast]).unwrap();
+        assert_eq!(set.cue(), Cue::TimeHeadway);
+        assert!(set.revealed_exactly() && set.explains());
+        let (lowest, highest) = set.thresholds();
+        assert_eq!(lowest, highest);
+        assert!((highest - 1.2).abs() < 0.05, "{highest}");
+        assert_eq!(set.smallest_accepted_lead_gap_s(), None);
+        assert_eq!(set.lag_gap_s(), 0.0);
+        let line = set.describe();
+        assert!(line.contains("time-headway at 1.2"), "{line}");
+        assert!(line.contains("what 2 starts allow"), "{line}");
+        // Waits alone bound the headway to an interval, up to their ceiling.
+        let wait = palc_aggregator::Onset {
+            time_headway_ceiling_s: Some(1.5),
+            accepted_lead_time_gap_s: Some(1.1),
+            ..onset(0.9, 8.0, Some(0.4))
+        };
+        let set = GapAcceptanceSet::from_onsets(&[wait]).unwrap();
+        assert_eq!(set.thresholds(), (0.9, 1.5));
+        assert_eq!(set.lag_gap_s(), 0.4);
+        assert_eq!(set.smallest_accepted_lead_gap_s(), Some(1.1));
+        let line = set.describe();
+        assert!(line.contains("from 0.90 to 1.50 s"), "{line}");
+        assert!(
+            line.contains("leader's gap between 0.00 and 1.10 s"),
+            "{line}"
+        );
+        assert!(line.contains("follower's gap of 0.40 s"), "{line}");
     }
 }

@@ -31,7 +31,7 @@ impl GapAcceptanceSet {
     /// (`duration_s` from the start, on the lane-keeping prediction): a start
     /// whose lane change the layer would refuse is not predicted. `None` when the
     /// prediction does not start within the search window.
-    pub(crate) fn predicted_start_s(&self, setup: &Setup, duration_s: f64) -> Option<f64> {
+    pub fn predicted_start_s(&self, setup: &Setup, duration_s: f64) -> Option<f64> {
         let DecisionRange {
             feature,
             lowest,
