@@ -98,8 +98,14 @@ pub(crate) fn starting_experience(
             // 0099).
             let set = GapAcceptanceSet::from_onsets(&previous.onsets);
             let exact = set.as_ref().is_some_and(GapAcceptanceSet::revealed_exactly);
-            (estimated.start_s)
-                .filter(|_| estimated.on_another_cue || !exact)
+            // Where the estimate is sure of a reaction on a cue the set reads,
+            // the shortest reaction that makes the starts one threshold places
+            // the start to the step, if the set finds one (0102).
+            let reacting = (set.as_ref())
+                .and_then(GapAcceptanceSet::with_reaction)
+                .filter(|_| estimated.on_a_reaction);
+            (reacting.and_then(|set| set.predicted_start_s(setup, lane_change)))
+                .or_else(|| (estimated.start_s).filter(|_| estimated.on_another_cue || !exact))
                 // Where no cue the set reads is consistent across the scenes, its
                 // model does not explain them: the estimate's most probable
                 // start, however unsure (0095).

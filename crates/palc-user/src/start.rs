@@ -76,7 +76,13 @@ impl StartModel {
     /// The reaction in whole steps of `dt`, rounding up (1e-9 absorbs a delay
     /// that is a multiple of the step up to rounding).
     pub fn reaction_steps(&self, dt: f64) -> usize {
-        (self.reaction_s / dt - 1e-9).ceil().max(0.0) as usize
+        StartModel::steps_of_reaction(self.reaction_s, dt)
+    }
+
+    /// A reaction of `reaction_s` in whole steps of `dt`, as
+    /// [`StartModel::reaction_steps`] counts it.
+    pub fn steps_of_reaction(reaction_s: f64, dt: f64) -> usize {
+        (reaction_s / dt - 1e-9).ceil().max(0.0) as usize
     }
 
     /// The decision's step and the start's step in `situations` (step `dt`),

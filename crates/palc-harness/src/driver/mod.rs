@@ -46,7 +46,9 @@
 //! they do not read keeps the estimate's start there. Where no
 //! feature the readings read is consistent across the free starts (their own
 //! model contradicted), the estimate's most probable start step predicts
-//! however unsure it is (0095).
+//! however unsure it is (0095). Where it puts 95 % on a reaction after a decision
+//! on a cue the readings read, the readings' shortest reaction that makes the
+//! free starts one threshold places the start, if they find one (0102).
 
 mod estimate;
 mod memo;
@@ -119,6 +121,11 @@ pub(crate) struct CarriedEstimate {
     /// prior's, which the scenes do not decide at its 0.2 s resolution
     /// (docs/experiments/0099-a-reaction-the-scenes-do-not-show.md).
     pub on_another_cue: bool,
+    /// [`CREDIBLE_MASS`] of the posterior is on a reaction after a decision on
+    /// a cue the readings read. The carry then asks the readings for the
+    /// shortest reaction that makes the starts one threshold
+    /// (docs/experiments/0102-a-reaction-the-starts-reveal.md).
+    pub on_a_reaction: bool,
     /// The start (s) of the step with the largest posterior predictive mass,
     /// however small that mass; the carry uses it where the readings' own
     /// model is contradicted (`crate::onset::readings_explain`). `None` below
@@ -155,6 +162,7 @@ pub(crate) fn start_beyond_readings(
         return CarriedEstimate {
             start_s: None,
             on_another_cue: false,
+            on_a_reaction: false,
             most_likely_s: None,
             belief,
         };
@@ -182,9 +190,12 @@ pub(crate) fn start_beyond_readings(
     let most_likely_s = (step < setup.situations.len()).then_some(step as f64 * setup.dt);
     let start_s = most_likely_s.filter(|_| predicts);
     let another_cue = estimate.mass_where(|cue, _| !READ_BY_THE_READINGS.contains(&cue));
+    let reaction = estimate
+        .mass_where(|cue, reaction_s| READ_BY_THE_READINGS.contains(&cue) && reaction_s > 0.0);
     CarriedEstimate {
         start_s,
         on_another_cue: start_s.is_some() && another_cue >= CREDIBLE_MASS,
+        on_a_reaction: reaction >= CREDIBLE_MASS,
         most_likely_s,
         belief,
     }

@@ -52,6 +52,17 @@ pub(crate) fn arterial_setup() -> &'static Setup {
 /// [`Situation::decides_at`](palc_user::Situation::decides_at) holds), read as the
 /// readings read it.
 pub(crate) fn onset_of_a_closing_scene(speed: f64, closing: f64, threshold: f64) -> Onset {
+    onset_of_a_reacting_driver(speed, closing, threshold, 0)
+}
+
+/// [`onset_of_a_closing_scene`] for a user who starts `reaction` steps (of
+/// 0.1 s) after deciding.
+pub(crate) fn onset_of_a_reacting_driver(
+    speed: f64,
+    closing: f64,
+    threshold: f64,
+    reaction: usize,
+) -> Onset {
     let dt = 0.1;
     let steps: Vec<SeenStep> = (0..3000)
         .map(|i| SeenStep {
@@ -70,7 +81,8 @@ pub(crate) fn onset_of_a_closing_scene(speed: f64, closing: f64, threshold: f64)
     let seen = crate::driver::situation;
     let start = (scene.steps.iter())
         .position(|s| seen(s).decides_at(threshold))
-        .unwrap();
+        .unwrap()
+        + reaction;
     let headway = |i: usize| seen(&scene.steps[i]).time_headway_s;
     Onset {
         time_s: start as f64 * dt,

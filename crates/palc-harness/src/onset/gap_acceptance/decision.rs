@@ -5,6 +5,9 @@ use palc_aggregator::Onset;
 use palc_user::Situation;
 
 use super::start_in_scene;
+use palc_user::{MAX_REACTION_S, StartModel};
+
+use crate::driver::READ_BY_THE_READINGS;
 use crate::driver::prior::Cue;
 use crate::onset::cues::{cue_value, onset_value};
 
@@ -49,6 +52,10 @@ pub(super) struct DecisionRange {
     /// onsets, or over all when none is free) and no held-back start
     /// contradicts it. Always so for a single onset.
     pub(super) explained: bool,
+    /// The reaction (s) between the decision and the earliest start: 0 but
+    /// where no cue has one threshold every free start allows and a reaction
+    /// gives one ([`reaction_range`]).
+    pub(super) reaction_s: f64,
 }
 
 impl DecisionRange {
@@ -59,6 +66,7 @@ impl DecisionRange {
             highest: threshold,
             revealed_by,
             explained: true,
+            reaction_s: 0.0,
         }
     }
 }
@@ -133,6 +141,7 @@ pub(super) fn decision_range(onsets: &[Onset]) -> DecisionRange {
             highest: headway.1,
             revealed_by: 0,
             explained,
+            reaction_s: 0.0,
         },
     }
 }
@@ -164,6 +173,17 @@ fn free_onsets(onsets: &[Onset]) -> Vec<&Onset> {
 /// started), or the intervals do not intersect (a driver whose threshold is not
 /// one value): the midpoints stand.
 fn revealed_interval(free: &[&Onset], feature: Cue) -> Option<(f64, f64)> {
+    revealed_interval_after(free, feature, 0.0)
+}
+
+/// [`revealed_interval`] for a driver who starts `reaction_s` after deciding
+/// (in whole steps of each scene, as palc-user's
+/// [`StartModel::reaction_steps`](palc_user::StartModel::reaction_steps) counts
+/// them): a start at step `k` says the feature had fallen to the threshold
+/// `r` steps before, `θ ∈ [x(k − r), x(k − r − 1))`. `None` also where a
+/// scene's start comes too early for the reaction (a decision at the scene's
+/// first step or before it).
+fn revealed_interval_after(free: &[&Onset], feature: Cue, reaction_s: f64) -> Option<(f64, f64)> {
     if free.is_empty() {
         return None;
     }
@@ -171,12 +191,46 @@ fn revealed_interval(free: &[&Onset], feature: Cue) -> Option<(f64, f64)> {
     let (mut lowest, mut highest) = (f64::NEG_INFINITY, f64::INFINITY);
     for onset in free {
         let (scene, step) = start_in_scene(onset)?;
-        lowest = lowest.max(value(&crate::driver::situation(&scene.steps[step]))?);
-        if let Some(before) = value(&crate::driver::situation(&scene.steps[step - 1])) {
+        let reaction = StartModel::steps_of_reaction(reaction_s, scene.dt);
+        let decided = step.checked_sub(reaction).filter(|&d| d >= 1)?;
+        lowest = lowest.max(value(&crate::driver::situation(&scene.steps[decided]))?);
+        if let Some(before) = value(&crate::driver::situation(&scene.steps[decided - 1])) {
             highest = highest.min(before);
         }
     }
     (lowest < highest && highest.is_finite()).then_some((lowest, highest))
+}
+
+/// Where two or more free starts are no threshold of any cue the set reads
+/// (their intervals meet for none, [`revealed_interval`]), the decision of a
+/// driver who starts a reaction after deciding, as palc-user's users of a
+/// reaction do: the shortest reaction, in steps of the first free start's
+/// scene up to palc-user's largest ([`MAX_REACTION_S`]), after which one cue's
+/// intervals meet, the time headway's first among equals (the paper's cue),
+/// and the middle of what they allow. The driver's own reaction always lets its
+/// threshold's intervals meet, so the one found is never longer than the
+/// driver's. `None` where a cue needs none, below two free starts, or where no
+/// reaction makes the starts one threshold.
+pub(super) fn reaction_range(onsets: &[Onset]) -> Option<DecisionRange> {
+    let onsets = &reread_follower_waits(onsets);
+    let free = free_onsets(onsets);
+    if free.len() < 2
+        || (READ_BY_THE_READINGS.iter()).any(|&c| revealed_interval(&free, c).is_some())
+    {
+        return None;
+    }
+    let dt = start_in_scene(free[0])?.0.dt;
+    let longest = (MAX_REACTION_S / dt).round() as usize;
+    (1..=longest).find_map(|steps| {
+        let reaction_s = steps as f64 * dt;
+        (READ_BY_THE_READINGS.iter()).find_map(|&cue| {
+            let (lowest, highest) = revealed_interval_after(&free, cue, reaction_s)?;
+            Some(DecisionRange {
+                reaction_s,
+                ..DecisionRange::one(cue, 0.5 * (lowest + highest), free.len())
+            })
+        })
+    })
 }
 
 /// `onsets` with each start that was read as a wait for the follower
@@ -214,7 +268,7 @@ fn reread_follower_waits(onsets: &[Onset]) -> Vec<Onset> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::onset::test_scenes::{onset, onset_of_a_closing_scene};
+    use crate::onset::test_scenes::{onset, onset_of_a_closing_scene, onset_of_a_reacting_driver};
 
     #[test]
     fn the_decision_is_the_headway_unless_another_feature_is_consistent() {
@@ -329,6 +383,61 @@ mod tests {
             proptest::prop_assert!((range.highest - 0.5 * (lowest + highest)).abs() < 1e-12);
             proptest::prop_assert_eq!(range.revealed_by, onsets.len());
         }
+    }
+
+    proptest::proptest! {
+        #![proptest_config(proptest::prelude::ProptestConfig::with_cases(128))]
+
+        /// Whatever the scenes a user who decides at one time headway and
+        /// starts a reaction later started in, the interval its starts allow
+        /// after its own reaction contains its threshold, and the reaction the
+        /// set finds, if any, is never longer than its own.
+        #[test]
+        fn a_reacting_users_threshold_and_reaction_lie_in_the_set(
+            threshold in 0.8f64..2.5,
+            reaction in 0usize..12,
+            scenes in proptest::collection::vec((10.0f64..35.0, 0.5f64..8.0), 2..6),
+        ) {
+            let onsets: Vec<Onset> = (scenes.iter())
+                .map(|&(speed, closing)| onset_of_a_reacting_driver(speed, closing, threshold, reaction))
+                .collect();
+            let free: Vec<&Onset> = onsets.iter().collect();
+            let reaction_s = reaction as f64 * 0.1;
+            let (lowest, highest) =
+                revealed_interval_after(&free, Cue::TimeHeadway, reaction_s).unwrap();
+            proptest::prop_assert!(
+                lowest <= threshold && threshold < highest,
+                "{} not in [{}, {})", threshold, lowest, highest
+            );
+            if let Some(found) = reaction_range(&onsets) {
+                proptest::prop_assert!(found.reaction_s <= reaction_s + 1e-9, "{:?}", found);
+            }
+        }
+    }
+
+    /// A driver of a 0.8 s reaction seen in three scenes closing at rates from
+    /// 0.5 to 8 m/s: its starts are no threshold of any cue without a reaction,
+    /// and the shortest reaction that makes them one is its own (scenes closing
+    /// at closer rates can leave a shorter one, never a longer one: the
+    /// property above).
+    #[test]
+    fn the_shortest_reaction_that_makes_the_starts_one_threshold_is_found() {
+        let onsets: Vec<Onset> = [(20.0, 0.5), (30.0, 8.0), (12.0, 6.0)]
+            .iter()
+            .map(|&(speed, closing)| onset_of_a_reacting_driver(speed, closing, 1.3, 8))
+            .collect();
+        assert_eq!(decision_range(&onsets).revealed_by, 0);
+        let found = reaction_range(&onsets).expect("a reaction makes them one threshold");
+        assert_eq!(found.feature, Cue::TimeHeadway);
+        assert!((found.reaction_s - 0.8).abs() < 1e-9, "{found:?}");
+        assert!((found.highest - 1.3).abs() < 0.02, "{found:?}");
+        assert_eq!(found.revealed_by, 3);
+        // A driver without a reaction needs none.
+        let instant: Vec<Onset> = [(20.0, 1.0), (25.0, 6.0)]
+            .iter()
+            .map(|&(speed, closing)| onset_of_a_closing_scene(speed, closing, 1.3))
+            .collect();
+        assert_eq!(reaction_range(&instant), None);
     }
 
     /// Two scenes whose largest midpoint lies above what the other allows: the

@@ -36,7 +36,7 @@ use crate::driver::prior::Cue;
 pub(crate) use decision::decision;
 pub(crate) use gaps::assumed_lead_gap_s;
 
-use decision::{DecisionRange, decision_range};
+use decision::{DecisionRange, decision_range, reaction_range};
 use gaps::{acceptance, lag_acceptance};
 
 /// The gap-acceptance drivers a user's onsets allow: the cue it decides on with
@@ -55,6 +55,9 @@ pub struct GapAcceptanceSet {
     smallest_accepted_lead_s: f64,
     /// The follower's time gap (s) the driver needs.
     lag_s: f64,
+    /// Where the free starts are no threshold of any cue without a reaction,
+    /// the decision of the shortest reaction that makes them one.
+    reacting: Option<DecisionRange>,
 }
 
 impl GapAcceptanceSet {
@@ -83,6 +86,7 @@ impl GapAcceptanceSet {
             lead_at_least_s: acceptance(onsets, |o| o.lead_time_gap_s).max(refused),
             smallest_accepted_lead_s: accepted,
             lag_s: lag_acceptance(onsets),
+            reacting: reaction_range(onsets),
         })
     }
 
@@ -103,6 +107,25 @@ impl GapAcceptanceSet {
     /// (docs/experiments/0095-a-wait-weighed-by-the-prior-and-readings-that-contradict-themselves.md).
     pub fn explains(&self) -> bool {
         self.decision.explained
+    }
+
+    /// The same set for a driver who starts a reaction after deciding, where
+    /// two or more free starts are no threshold of any cue without one and the
+    /// shortest reaction that makes them one is found (`decision::reaction_range`):
+    /// its cue, the middle of the interval the starts allow after it, and the
+    /// reaction. `None` otherwise.
+    pub fn with_reaction(&self) -> Option<GapAcceptanceSet> {
+        self.reacting.map(|decision| GapAcceptanceSet {
+            decision,
+            reacting: None,
+            ..*self
+        })
+    }
+
+    /// The reaction (s) between the decision and the earliest start: 0 but for
+    /// a set [`GapAcceptanceSet::with_reaction`] gave.
+    pub fn reaction_s(&self) -> f64 {
+        self.decision.reaction_s
     }
 
     /// The cue the driver is believed to decide on.
@@ -166,13 +189,17 @@ impl GapAcceptanceSet {
             ),
             None => format!("of {:.2} s or more", self.lead_gap_at_least_s()),
         };
+        let reaction = match self.reaction_s() {
+            0.0 => String::new(),
+            r => format!(" {r:.1} s before starting"),
+        };
         let unexplained = if self.explains() {
             ""
         } else {
             "; no cue agrees across the scenes, so the estimate predicts"
         };
         format!(
-            "decides on the {} {thresholds}, needs a leader's gap {lead} and a \
+            "decides on the {} {thresholds}{reaction}, needs a leader's gap {lead} and a \
              follower's gap of {:.2} s{unexplained}",
             self.cue().name(),
             self.lag_gap_s(),
@@ -194,7 +221,7 @@ fn start_in_scene(onset: &Onset) -> Option<(&SceneSteps, usize)> {
 mod tests {
     use super::GapAcceptanceSet;
     use crate::driver::prior::Cue;
-    use crate::onset::test_scenes::{onset, onset_of_a_closing_scene};
+    use crate::onset::test_scenes::{onset, onset_of_a_closing_scene, onset_of_a_reacting_driver};
 
     fn explains(onsets: &[palc_aggregator::Onset]) -> bool {
         GapAcceptanceSet::from_onsets(onsets).unwrap().explains()
@@ -258,5 +285,32 @@ mod tests {
             "{line}"
         );
         assert!(line.contains("follower's gap of 0.40 s"), "{line}");
+    }
+
+    #[test]
+    fn a_set_with_a_reaction_says_so_and_starts_after_it() {
+        let onsets: Vec<palc_aggregator::Onset> = [(20.0, 0.5), (30.0, 8.0), (12.0, 6.0)]
+            .iter()
+            .map(|&(speed, closing)| onset_of_a_reacting_driver(speed, closing, 1.3, 8))
+            .collect();
+        let set = GapAcceptanceSet::from_onsets(&onsets).unwrap();
+        assert_eq!(set.reaction_s(), 0.0);
+        assert!(!set.revealed_exactly());
+        let reacting = set
+            .with_reaction()
+            .expect("a reaction makes them one threshold");
+        assert!((reacting.reaction_s() - 0.8).abs() < 1e-9);
+        assert!(reacting.revealed_exactly());
+        assert!(reacting.with_reaction().is_none());
+        let line = reacting.describe();
+        assert!(line.contains("0.8 s before starting"), "{line}");
+        // Without a reaction found, there is no such set.
+        let instant = [onset_of_a_closing_scene(20.0, 1.0, 1.3)];
+        assert!(
+            GapAcceptanceSet::from_onsets(&instant)
+                .unwrap()
+                .with_reaction()
+                .is_none()
+        );
     }
 }

@@ -4,7 +4,7 @@
 
 use std::collections::BTreeMap;
 
-use palc_user::Situation;
+use palc_user::{Situation, StartModel};
 
 use super::decision::DecisionRange;
 use super::{GapAcceptanceSet, assumed_lead_gap_s};
@@ -36,8 +36,10 @@ impl GapAcceptanceSet {
             feature,
             lowest,
             highest: threshold,
+            reaction_s,
             ..
         } = self.decision;
+        let reaction = StartModel::steps_of_reaction(reaction_s, setup.dt);
         // What the user needs from the leader: at least what held it back or
         // what it refused; of the rest, what the system itself requires until
         // the user has accepted a smaller gap (what it accepted bounds its
@@ -78,11 +80,13 @@ impl GapAcceptanceSet {
         // feature are equal, and a start wins only by more than that.
         let resolution = decisions.iter().map(|&(_, w)| w).fold(0.0, f64::max);
         for (decided, width) in decisions {
+            // The driver starts its reaction after deciding at the earliest.
+            let earliest = decided + reaction;
             // The first accepted step from an earlier decision is the first from
             // this one too, unless this decision comes after it; with none from an
             // earlier decision there is none from a later one.
-            if start.is_none_or(|s| s < decided) {
-                start = (decided..situations.len()).find(|&i| accepts(i));
+            if start.is_none_or(|s| s < earliest) {
+                start = (earliest..situations.len()).find(|&i| accepts(i));
             }
             let Some(start) = start else { break };
             *weight.entry(start).or_default() += width;
@@ -137,7 +141,9 @@ fn decision_steps(setup: &Setup, feature: Cue, (lowest, highest): (f64, f64)) ->
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::onset::test_scenes::{arterial_setup, learn_scene, onset};
+    use crate::onset::test_scenes::{
+        arterial_setup, learn_scene, onset, onset_of_a_reacting_driver,
+    };
 
     /// The first step at which a threshold of the time headway decides, by its
     /// definition: the slower reference of [`decision_steps`].
@@ -213,5 +219,52 @@ mod tests {
         let setup = arterial_setup();
         let one = decision_steps(setup, Cue::TimeHeadway, (1.5, 1.5));
         assert_eq!(one, vec![(deciding_step(setup, 1.5).unwrap(), 1.0)]);
+    }
+
+    /// A driver of a 0.8 s reaction, its threshold and reaction found from three
+    /// scenes, starts in a new one (the target lane empty) where it does: 8
+    /// steps after its decision, where the same threshold without the reaction
+    /// starts.
+    #[test]
+    fn a_set_with_a_reaction_starts_where_the_driver_does() {
+        let mut setup = learn_scene();
+        for situation in &mut setup.situations {
+            (situation.target_lead_gap_m, situation.target_lag_gap_m) = (None, None);
+        }
+        let onsets: Vec<palc_aggregator::Onset> = [(20.0, 0.5), (30.0, 8.0), (12.0, 6.0)]
+            .iter()
+            .map(|&(speed, closing)| onset_of_a_reacting_driver(speed, closing, 1.3, 8))
+            .collect();
+        let set = GapAcceptanceSet::from_onsets(&onsets).unwrap();
+        let reacting = set.with_reaction().unwrap();
+        let driver = StartModel {
+            rule: palc_user::StartRule::TimeHeadway,
+            time_headway_s: 1.3,
+            reaction_s: 0.8,
+            min_lead_gap_s: 0.0,
+            min_lag_gap_s: 0.0,
+        };
+        let (decided, started) = driver
+            .start_step(&setup.situations, setup.dt, setup.set_speed, |_| true)
+            .unwrap();
+        assert_eq!(started, decided + 8);
+        let close = |a: f64, b: usize| (a - b as f64 * setup.dt).abs() < 1e-9;
+        let predicted = reacting.predicted_start_s(&setup, 2.0).unwrap();
+        assert!(
+            close(predicted, started),
+            "{predicted} against step {started}"
+        );
+        let instant = GapAcceptanceSet {
+            decision: DecisionRange {
+                reaction_s: 0.0,
+                ..reacting.decision
+            },
+            ..reacting
+        };
+        let predicted = instant.predicted_start_s(&setup, 2.0).unwrap();
+        assert!(
+            close(predicted, decided),
+            "{predicted} against step {decided}"
+        );
     }
 }
