@@ -5,6 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Context;
 use clap::Args;
 use palc_aggregator::{Experience, output};
+use palc_harness::advanced::GapAcceptanceSet;
 use palc_harness::driver::DriverEstimate;
 use palc_harness::{
     CellChoice, LaneChangeRecord, LearnConfig, LessonEvent, Method, Observer, RunSummary,
@@ -205,6 +206,12 @@ pub fn run_learn(args: LearnArgs) -> anyhow::Result<()> {
         say!(
             "after the run, the driver as palc believes: {}",
             estimate.describe()
+        );
+    }
+    if let Some(set) = GapAcceptanceSet::from_onsets(&result.experience.onsets) {
+        say!(
+            "after the run, the starts allow a driver who {}",
+            set.describe()
         );
     }
     if let Some(path) = &args.save_experience {
