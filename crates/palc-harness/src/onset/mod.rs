@@ -3,7 +3,7 @@
 //! docs/experiments/0043-predicting-the-start.md).
 //!
 //! A takeover shows the user's own lateral profile from the takeover on. Its start
-//! is found by fitting a lane-change model through two crossings of it ([`Shape`](fit::Shape)):
+//! is found by fitting a lane-change model through two crossings of it ([`Shape`](shape::Shape)):
 //! the paper's quintic or a half-sine lateral speed, each symmetric or skewed (its
 //! lateral speed peaking earlier or later than mid-move), keeping the model closest
 //! to the profile up to the upper crossing. With `x(p)` the inverse of the model's
@@ -54,12 +54,13 @@ mod gap_acceptance;
 mod observed;
 mod own_shape;
 mod power;
+mod shape;
 #[cfg(test)]
 mod test_scenes;
 
-#[cfg(test)]
-pub(crate) use fit::Shape;
 pub(crate) use fit::UserLaneChange;
 pub use gap_acceptance::GapAcceptanceSet;
 pub(crate) use observed::{onset_at, start_clear_of_vehicles_beside};
 pub(crate) use own_shape::OwnShape;
+#[cfg(test)]
+pub(crate) use shape::Shape;

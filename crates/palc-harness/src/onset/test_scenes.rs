@@ -1,7 +1,8 @@
-//! Scenes and onsets the onset module's tests share.
+//! Scenes, onsets and lane-change shapes the onset module's tests share.
 
 use palc_aggregator::{Onset, SceneSteps, SeenStep};
 
+use super::shape::{Base, Shape};
 use crate::setup::Setup;
 
 /// The scene of `configs/learn.toml`, whose target-lane vehicles a test sets.
@@ -90,4 +91,17 @@ pub(crate) fn onset_of_a_reacting_driver(
         scene: Some(scene),
         ..onset(0.0, 10.0, None)
     }
+}
+
+/// Lane-change models of both bases, symmetric and skewed.
+pub(crate) fn shapes() -> Vec<Shape> {
+    let skewed = |base, peak| Shape { base, peak };
+    vec![
+        Shape::QUINTIC,
+        skewed(Base::HalfSine, 0.5),
+        skewed(Base::Quintic, 0.4),
+        skewed(Base::Quintic, 0.65),
+        skewed(Base::HalfSine, 0.3),
+        skewed(Base::HalfSine, 0.72),
+    ]
 }

@@ -4,7 +4,7 @@
 //!
 //! The model is the one the paper's user follows: the driver decides when one
 //! cue of the vehicle ahead (time headway, time to collision or gap,
-//! [`Cue`](crate::driver::prior::Cue)) has fallen to a threshold, then starts
+//! [`Cue`]) has fallen to a threshold, then starts
 //! at the first step from there at which the target lane's leader and follower
 //! are at least the time gaps it needs. Each onset is an observation of that
 //! model in its scene, and the set keeps what every observation allows
