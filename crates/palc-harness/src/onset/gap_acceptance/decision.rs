@@ -59,7 +59,7 @@ pub(super) struct DecisionRange {
 }
 
 impl DecisionRange {
-    fn one(feature: Cue, threshold: f64, revealed_by: usize) -> Self {
+    pub(super) fn one(feature: Cue, threshold: f64, revealed_by: usize) -> Self {
         DecisionRange {
             feature,
             lowest: threshold,
