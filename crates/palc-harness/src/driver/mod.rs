@@ -51,6 +51,7 @@
 //! free starts one threshold places the start, if they find one (0102).
 
 mod estimate;
+mod grid;
 mod memo;
 pub mod prior;
 mod scene;
