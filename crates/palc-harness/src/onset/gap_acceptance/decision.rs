@@ -219,8 +219,11 @@ pub(super) fn reaction_range(onsets: &[Onset]) -> Option<DecisionRange> {
     {
         return None;
     }
-    let dt = start_in_scene(free[0])?.0.dt;
-    let longest = (MAX_REACTION_S / dt).round() as usize;
+    let (scene, first_start) = start_in_scene(free[0])?;
+    // A reaction that reaches back past the first start's scene decides
+    // nowhere in it: the search ends there whatever the step.
+    let longest = ((MAX_REACTION_S / scene.dt).round() as usize).min(first_start - 1);
+    let dt = scene.dt;
     (1..=longest).find_map(|steps| {
         let reaction_s = steps as f64 * dt;
         (READ_BY_THE_READINGS.iter()).find_map(|&cue| {
@@ -438,6 +441,29 @@ mod tests {
             .map(|&(speed, closing)| onset_of_a_closing_scene(speed, closing, 1.3))
             .collect();
         assert_eq!(reaction_range(&instant), None);
+    }
+
+    /// A scene of a vanishing step (an experience file's, say) bounds the
+    /// reactions searched by its start's step, not by the largest reaction in
+    /// such steps (which would not end).
+    #[test]
+    fn the_reactions_searched_end_at_the_first_starts_step() {
+        let tiny = |onset: Onset| {
+            let mut scene = onset.scene.clone().unwrap();
+            scene.dt = 1e-300;
+            Onset {
+                time_s: onset.time_s / 0.1 * 1e-300,
+                scene: Some(scene),
+                ..onset
+            }
+        };
+        let onsets: Vec<Onset> = [(20.0, 0.5), (30.0, 8.0), (12.0, 6.0)]
+            .iter()
+            .map(|&(speed, closing)| tiny(onset_of_a_reacting_driver(speed, closing, 1.3, 8)))
+            .collect();
+        assert!(start_in_scene(&onsets[0]).is_some());
+        let found = reaction_range(&onsets).expect("the steps are the scene's own");
+        assert!((found.reaction_s - 8e-300).abs() < 1e-309, "{found:?}");
     }
 
     /// Two scenes whose largest midpoint lies above what the other allows: the
