@@ -76,7 +76,19 @@ impl DecisionRange {
 /// threshold above the largest headway at which the user started (the onsets
 /// bound the decision to that interval and say nothing more).
 pub(super) fn decision_range(onsets: &[Onset]) -> DecisionRange {
-    let onsets = &reread_follower_waits(onsets);
+    range_of_reread(&reread_follower_waits(onsets))
+}
+
+/// [`decision_range`] and [`reaction_range`] of `onsets`, their waits read
+/// again once for both ([`reread_follower_waits`] copies every onset with its
+/// scene).
+pub(super) fn decision_and_reaction(onsets: &[Onset]) -> (DecisionRange, Option<DecisionRange>) {
+    let reread = reread_follower_waits(onsets);
+    (range_of_reread(&reread), reaction_range(&reread))
+}
+
+/// [`decision_range`] of onsets whose waits were read again.
+fn range_of_reread(onsets: &[Onset]) -> DecisionRange {
     let free = free_onsets(onsets);
     let informative: Vec<&Onset> = if free.is_empty() {
         onsets.iter().collect()
@@ -211,8 +223,10 @@ fn revealed_interval_after(free: &[&Onset], feature: Cue, reaction_s: f64) -> Op
 /// threshold's intervals meet, so the one found is never longer than the
 /// driver's. `None` where a cue needs none, below two free starts, or where no
 /// reaction makes the starts one threshold.
-pub(super) fn reaction_range(onsets: &[Onset]) -> Option<DecisionRange> {
-    let onsets = &reread_follower_waits(onsets);
+///
+/// `onsets` are the ones whose waits were read again
+/// ([`reread_follower_waits`], [`decision_and_reaction`]).
+fn reaction_range(onsets: &[Onset]) -> Option<DecisionRange> {
     let free = free_onsets(onsets);
     if free.len() < 2
         || (READ_BY_THE_READINGS.iter()).any(|&c| revealed_interval(&free, c).is_some())
