@@ -43,7 +43,9 @@
 //! below the standard ALC's decision headway, with the follower's gap opening
 //! into it, is read as a wait for that gap (every user decides before the
 //! standard ALC does: the paper's premise); two or more such waits need the
-//! middle of the follower's gaps all their scenes allow. A lead gap the user
+//! middle of the follower's gaps all their scenes allow, and where the starts of
+//! two or more scenes, read as decisions, reveal one threshold, waits are read
+//! as decisions (the scenes need no follower's gap). A lead gap the user
 //! accepted bounds the one it needs from above; until it has accepted one
 //! smaller than the standard ALC's requirement, that requirement is assumed (the
 //! system's own, not fitted to any user).

@@ -4,6 +4,7 @@
 use palc_aggregator::Onset;
 use palc_user::Situation;
 
+use super::gaps::lag_acceptance;
 use super::start_in_scene;
 use palc_user::{MAX_REACTION_S, StartModel};
 
@@ -82,9 +83,15 @@ pub(super) fn decision_range(onsets: &[Onset]) -> DecisionRange {
 /// [`decision_range`] and [`reaction_range`] of `onsets`, their waits read
 /// again once for both ([`reread_follower_waits`] copies every onset with its
 /// scene).
-pub(super) fn decision_and_reaction(onsets: &[Onset]) -> (DecisionRange, Option<DecisionRange>) {
+pub(super) fn decision_and_reaction(
+    onsets: &[Onset],
+) -> (DecisionRange, Option<DecisionRange>, f64) {
     let reread = reread_follower_waits(onsets);
-    (range_of_reread(&reread), reaction_range(&reread))
+    (
+        range_of_reread(&reread),
+        reaction_range(&reread),
+        lag_acceptance(&reread),
+    )
 }
 
 /// [`decision_range`] of onsets whose waits were read again.
@@ -250,36 +257,62 @@ fn reaction_range(onsets: &[Onset]) -> Option<DecisionRange> {
     })
 }
 
-/// `onsets` with each start that was read as a wait for the follower
-/// (`observed::waited_for_the_follower`) read again as the user's own decision when
-/// another onset started with a smaller follower gap than the one the wait
-/// learned (by more than [`CONSISTENT_SPREAD`]): a user who accepts that
-/// smaller gap did not wait for the larger one
-/// (the accepted gap bounds the needed one from above), so the start is where it
-/// decided, at the headway it had there. One scene cannot tell the two readings
-/// apart; a time-to-collision user who decides below the standard ALC's headway
-/// as the follower's gap opens looks like a user who waited for that gap
-/// (docs/experiments/0060-a-wait-the-standard-alc-would-not-make.md; the reading
-/// again is measured in docs/experiments/0061-a-wait-read-again.md).
+/// `onsets` with the starts read as waits for the follower
+/// (`observed::waited_for_the_follower`) read again as the user's own decisions,
+/// at the headway each started at, where the scenes say so.
+///
+/// One scene cannot tell the two readings apart: both place the start where it
+/// was, and the paper's premise (every user decides before the standard ALC)
+/// chooses the wait (docs/experiments/0093-a-wait-for-the-follower-or-a-closer-decision.md).
+/// Two or more scenes can:
+/// - every start is read as a decision where, so read, the free starts reveal
+///   one threshold of a cue (the intervals their scenes allow meet,
+///   `DecisionRange::revealed_by`) that no held-back start contradicts
+///   (`DecisionRange::explained`). The wait needs one more parameter (the
+///   follower's gap) to explain what the decision explains without it; a
+///   recorded driver who decides closer than the standard ALC does so in
+///   every scene (docs/experiments/0103-waits-the-other-scenes-do-not-need.md);
+/// - otherwise a wait is read again as a decision where another onset started
+///   with a smaller follower gap than the one the wait learned (by more than
+///   [`CONSISTENT_SPREAD`]): a user who accepts that smaller gap did not wait for
+///   the larger one (the accepted gap bounds the needed one from above). A
+///   time-to-collision user who decides below the standard ALC's headway as the
+///   follower's gap opens looks like a user who waited for that gap
+///   (docs/experiments/0060-a-wait-the-standard-alc-would-not-make.md,
+///   docs/experiments/0061-a-wait-read-again.md).
 fn reread_follower_waits(onsets: &[Onset]) -> Vec<Onset> {
+    let decisions: Vec<Onset> = onsets.iter().map(read_as_decision).collect();
+    if onsets.len() >= 2 {
+        let range = range_of_reread(&decisions);
+        if range.explained && range.revealed_by >= 2 {
+            return decisions;
+        }
+    }
     let smaller_lag_elsewhere = |i: usize, gap: f64| {
         (onsets.iter().enumerate()).any(|(j, o)| {
             j != i && (o.lag_time_gap_s).is_some_and(|g| g < gap * (1.0 - CONSISTENT_SPREAD))
         })
     };
     (onsets.iter().enumerate())
-        .map(
-            |(i, o)| match (o.follower_wait_time_headway_s, o.lag_time_gap_s) {
-                (Some(headway), Some(gap)) if smaller_lag_elsewhere(i, gap) => Onset {
-                    time_headway_s: headway,
-                    lag_time_gap_s: None,
-                    follower_wait_time_headway_s: None,
-                    ..o.clone()
-                },
-                _ => o.clone(),
-            },
-        )
+        .map(|(i, o)| match o.lag_time_gap_s {
+            Some(gap) if smaller_lag_elsewhere(i, gap) => read_as_decision(o),
+            _ => o.clone(),
+        })
         .collect()
+}
+
+/// `onset` with a start read as a wait for the follower read as the user's own
+/// decision instead, at the headway it started at; any other onset unchanged.
+fn read_as_decision(onset: &Onset) -> Onset {
+    match (onset.follower_wait_time_headway_s, onset.lag_time_gap_s) {
+        (Some(headway), Some(_)) => Onset {
+            time_headway_s: headway,
+            lag_time_gap_s: None,
+            follower_wait_time_headway_s: None,
+            ..onset.clone()
+        },
+        _ => onset.clone(),
+    }
 }
 
 #[cfg(test)]
@@ -356,6 +389,50 @@ mod tests {
         };
         let both = [waited, again];
         assert_eq!(reread_follower_waits(&both), both.to_vec());
+    }
+
+    /// The onset of a user who decides at the time headway `threshold` in a
+    /// scene closing at `closing` m/s from `speed` m/s, with every cue read at its
+    /// start as the readings read them (the middle of its values at the start's
+    /// step and the step before).
+    fn decided(speed: f64, closing: f64, threshold: f64) -> Onset {
+        let onset = onset_of_a_closing_scene(speed, closing, threshold);
+        let (scene, step) = start_in_scene(&onset).unwrap();
+        let at = |cue: Cue| {
+            let value = |i: usize| cue_value(cue, &crate::driver::situation(&scene.steps[i]));
+            Some(0.5 * (value(step)? + value(step - 1)?))
+        };
+        Onset {
+            ttc_s: at(Cue::TimeToCollision),
+            gap_m: at(Cue::DistanceGap).unwrap(),
+            ..onset
+        }
+    }
+
+    #[test]
+    fn waits_are_decisions_where_the_decisions_reveal_one_threshold() {
+        // A start at a headway of 0.9 s as the follower's gap opened, read as a
+        // wait for that gap with the decision at the standard ALC's 1.0 s.
+        let start = decided(20.0, 2.0, 0.9);
+        let waited = Onset {
+            time_headway_s: 1.0,
+            follower_wait_time_headway_s: Some(start.time_headway_s),
+            lag_time_gap_s: Some(0.59),
+            ..start.clone()
+        };
+        // Alone it stays a wait: one scene cannot tell.
+        let alone = std::slice::from_ref(&waited);
+        assert_eq!(reread_follower_waits(alone), alone.to_vec());
+        // Another scene's free start reveals the same threshold (their
+        // intervals of the headway meet): the start was the user's decision.
+        let free = decided(25.0, 3.0, 0.9);
+        let reread = reread_follower_waits(&[waited.clone(), free.clone()]);
+        assert_eq!(reread, vec![start, free]);
+        // A free start at 1.23 s: no threshold of any cue allows both starts
+        // as decisions, and the wait stands.
+        let earlier = decided(25.0, 3.0, 1.23);
+        let kept = [waited, earlier];
+        assert_eq!(reread_follower_waits(&kept), kept.to_vec());
     }
 
     #[test]

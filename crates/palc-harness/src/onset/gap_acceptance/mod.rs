@@ -37,7 +37,7 @@ pub(crate) use decision::decision;
 pub(crate) use gaps::assumed_lead_gap_s;
 
 use decision::{DecisionRange, decision_and_reaction};
-use gaps::{acceptance, lag_acceptance};
+use gaps::acceptance;
 
 /// The gap-acceptance drivers a user's onsets allow: the cue it decides on with
 /// the interval of its threshold, and the target-lane gaps it needs. What the
@@ -81,12 +81,12 @@ impl GapAcceptanceSet {
         // later than the threshold said) and bounds the need by the accepted gap
         // at most (docs/experiments/0073-a-drive-of-varied-scenes.md).
         let refused = refused.min(accepted);
-        let (decision, reacting) = decision_and_reaction(onsets);
+        let (decision, reacting, lag_s) = decision_and_reaction(onsets);
         Some(GapAcceptanceSet {
             decision,
             lead_at_least_s: acceptance(onsets, |o| o.lead_time_gap_s).max(refused),
             smallest_accepted_lead_s: accepted,
-            lag_s: lag_acceptance(onsets),
+            lag_s,
             reacting,
         })
     }
