@@ -314,7 +314,7 @@ impl<'a> UserDriving<'a> {
     /// instead of moving to `next` (step `i`, its path `held` steps late): the move
     /// would bring the ego's footprint into the target lane at a gap it does not
     /// enter. Every user holds beside a target-lane vehicle
-    /// ([`UserDriving::enters_beside`]). A user who waits for safe gaps
+    /// (`beside`). A user who waits for safe gaps
     /// (`planning.safety.users_wait_for_safe_gaps`) also holds when its lane change
     /// from here, driven on a clone of the scene to the horizon's end, would bring
     /// the target lane's lead or lag vehicle below the RSS safe distance while the

@@ -1,7 +1,7 @@
 //! Computations repeated from their inputs instead of done again: a closed-loop
 //! drive and a lesson that could not be learned.
 //!
-//! A closed-loop drive ([`ClosedLoop::drive_in`] without a world) is a function
+//! A closed-loop drive ([`ClosedLoop::drive_in`](crate::closed_loop::ClosedLoop::drive_in) without a world) is a function
 //! of its inputs alone: the scenario, the experience, the options, the first plan
 //! and whether the safety layer fell back; every re-plan builds a fresh planner.
 //! When a lesson teaches nothing (the `paper` method's lessons mostly fail, see
