@@ -77,21 +77,17 @@ impl DecisionRange {
 /// threshold above the largest headway at which the user started (the onsets
 /// bound the decision to that interval and say nothing more).
 pub(super) fn decision_range(onsets: &[Onset]) -> DecisionRange {
-    range_of_reread(&reread_follower_waits(onsets))
+    reread_follower_waits(onsets).1
 }
 
-/// [`decision_range`] and [`reaction_range`] of `onsets`, their waits read
-/// again once for both ([`reread_follower_waits`] copies every onset with its
-/// scene).
+/// [`decision_range`], [`reaction_range`] and the follower's gap needed
+/// (`gaps::lag_acceptance`) of `onsets`, their waits read again once for all
+/// three ([`reread_follower_waits`] copies every onset with its scene).
 pub(super) fn decision_and_reaction(
     onsets: &[Onset],
 ) -> (DecisionRange, Option<DecisionRange>, f64) {
-    let reread = reread_follower_waits(onsets);
-    (
-        range_of_reread(&reread),
-        reaction_range(&reread),
-        lag_acceptance(&reread),
-    )
+    let (reread, range) = reread_follower_waits(onsets);
+    (range, reaction_range(&reread), lag_acceptance(&reread))
 }
 
 /// [`decision_range`] of onsets whose waits were read again.
@@ -280,12 +276,16 @@ fn reaction_range(onsets: &[Onset]) -> Option<DecisionRange> {
 ///   follower's gap opens looks like a user who waited for that gap
 ///   (docs/experiments/0060-a-wait-the-standard-alc-would-not-make.md,
 ///   docs/experiments/0061-a-wait-read-again.md).
-fn reread_follower_waits(onsets: &[Onset]) -> Vec<Onset> {
-    let decisions: Vec<Onset> = onsets.iter().map(read_as_decision).collect();
-    if onsets.len() >= 2 {
+///
+/// Returned with the [`DecisionRange`] of the onsets so read, which the choice
+/// computes anyway.
+fn reread_follower_waits(onsets: &[Onset]) -> (Vec<Onset>, DecisionRange) {
+    let waited = |o: &Onset| o.follower_wait_time_headway_s.is_some() && o.lag_time_gap_s.is_some();
+    if onsets.len() >= 2 && onsets.iter().any(waited) {
+        let decisions: Vec<Onset> = onsets.iter().map(read_as_decision).collect();
         let range = range_of_reread(&decisions);
         if range.explained && range.revealed_by >= 2 {
-            return decisions;
+            return (decisions, range);
         }
     }
     let smaller_lag_elsewhere = |i: usize, gap: f64| {
@@ -293,12 +293,14 @@ fn reread_follower_waits(onsets: &[Onset]) -> Vec<Onset> {
             j != i && (o.lag_time_gap_s).is_some_and(|g| g < gap * (1.0 - CONSISTENT_SPREAD))
         })
     };
-    (onsets.iter().enumerate())
+    let reread: Vec<Onset> = (onsets.iter().enumerate())
         .map(|(i, o)| match o.lag_time_gap_s {
             Some(gap) if smaller_lag_elsewhere(i, gap) => read_as_decision(o),
             _ => o.clone(),
         })
-        .collect()
+        .collect();
+    let range = range_of_reread(&reread);
+    (reread, range)
 }
 
 /// `onset` with a start read as a wait for the follower read as the user's own
@@ -365,7 +367,7 @@ mod tests {
             ..onset(1.0, 8.0, Some(0.59))
         };
         let alone = std::slice::from_ref(&waited);
-        assert_eq!(reread_follower_waits(alone), alone.to_vec());
+        assert_eq!(reread_follower_waits(alone).0, alone.to_vec());
         assert_eq!(decision(alone), (Cue::TimeHeadway, 1.0));
         // Another scene in which it started as soon as a follower had cleared (a
         // gap of 0): it needs no 0.59 s behind, so the start was its decision.
@@ -373,7 +375,7 @@ mod tests {
             gap_m: 10.0,
             ..onset(1.41, 6.3, Some(0.0))
         };
-        let reread = reread_follower_waits(&[waited.clone(), held.clone()]);
+        let (reread, _) = reread_follower_waits(&[waited.clone(), held.clone()]);
         assert_eq!(reread[0].time_headway_s, 0.89);
         assert_eq!(reread[0].lag_time_gap_s, None);
         assert_eq!(reread[1], held);
@@ -388,7 +390,7 @@ mod tests {
             ..onset(1.0, 6.0, Some(0.62))
         };
         let both = [waited, again];
-        assert_eq!(reread_follower_waits(&both), both.to_vec());
+        assert_eq!(reread_follower_waits(&both).0, both.to_vec());
     }
 
     /// The onset of a user who decides at the time headway `threshold` in a
@@ -422,17 +424,17 @@ mod tests {
         };
         // Alone it stays a wait: one scene cannot tell.
         let alone = std::slice::from_ref(&waited);
-        assert_eq!(reread_follower_waits(alone), alone.to_vec());
+        assert_eq!(reread_follower_waits(alone).0, alone.to_vec());
         // Another scene's free start reveals the same threshold (their
         // intervals of the headway meet): the start was the user's decision.
         let free = decided(25.0, 3.0, 0.9);
-        let reread = reread_follower_waits(&[waited.clone(), free.clone()]);
+        let (reread, _) = reread_follower_waits(&[waited.clone(), free.clone()]);
         assert_eq!(reread, vec![start, free]);
         // A free start at 1.23 s: no threshold of any cue allows both starts
         // as decisions, and the wait stands.
         let earlier = decided(25.0, 3.0, 1.23);
         let kept = [waited, earlier];
-        assert_eq!(reread_follower_waits(&kept), kept.to_vec());
+        assert_eq!(reread_follower_waits(&kept).0, kept.to_vec());
     }
 
     #[test]
