@@ -5,7 +5,7 @@ use palc_aggregator::Onset;
 use palc_user::Situation;
 
 use super::gaps::lag_acceptance;
-use super::start_in_scene;
+use super::{is_follower_wait, start_in_scene};
 use palc_user::{MAX_REACTION_S, StartModel};
 
 use crate::driver::READ_BY_THE_READINGS;
@@ -280,8 +280,7 @@ fn reaction_range(onsets: &[Onset]) -> Option<DecisionRange> {
 /// Returned with the [`DecisionRange`] of the onsets so read, which the choice
 /// computes anyway.
 fn reread_follower_waits(onsets: &[Onset]) -> (Vec<Onset>, DecisionRange) {
-    let waited = |o: &Onset| o.follower_wait_time_headway_s.is_some() && o.lag_time_gap_s.is_some();
-    if onsets.len() >= 2 && onsets.iter().any(waited) {
+    if onsets.len() >= 2 && onsets.iter().any(is_follower_wait) {
         let decisions: Vec<Onset> = onsets.iter().map(read_as_decision).collect();
         let range = range_of_reread(&decisions);
         if range.explained && range.revealed_by >= 2 {
@@ -306,8 +305,8 @@ fn reread_follower_waits(onsets: &[Onset]) -> (Vec<Onset>, DecisionRange) {
 /// `onset` with a start read as a wait for the follower read as the user's own
 /// decision instead, at the headway it started at; any other onset unchanged.
 fn read_as_decision(onset: &Onset) -> Onset {
-    match (onset.follower_wait_time_headway_s, onset.lag_time_gap_s) {
-        (Some(headway), Some(_)) => Onset {
+    match onset.follower_wait_time_headway_s {
+        Some(headway) if is_follower_wait(onset) => Onset {
             time_headway_s: headway,
             lag_time_gap_s: None,
             follower_wait_time_headway_s: None,

@@ -4,7 +4,7 @@
 
 use palc_aggregator::Onset;
 
-use super::start_in_scene;
+use super::{is_follower_wait, start_in_scene};
 use crate::onset::cues::lag_time_gap;
 use crate::setup::Setup;
 
@@ -43,10 +43,7 @@ pub(super) fn acceptance(onsets: &[Onset], gap: fn(&Onset) -> Option<f64>) -> f6
 /// docs/experiments/0100-the-follower-gap-every-wait-allows.md). With one wait,
 /// or intervals that do not meet, each wait's own midpoint stands.
 pub(super) fn lag_acceptance(onsets: &[Onset]) -> f64 {
-    let waited = |o: &Onset| o.follower_wait_time_headway_s.is_some();
-    let waits: Vec<&Onset> = (onsets.iter())
-        .filter(|o| waited(o) && o.lag_time_gap_s.is_some())
-        .collect();
+    let waits: Vec<&Onset> = onsets.iter().filter(|o| is_follower_wait(o)).collect();
     let revealed = (waits.len() >= 2)
         .then(|| waited_gap_interval(&waits))
         .flatten()
@@ -54,7 +51,7 @@ pub(super) fn lag_acceptance(onsets: &[Onset]) -> f64 {
     (onsets.iter())
         .filter_map(|o| {
             o.lag_time_gap_s
-                .map(|g| revealed.filter(|_| waited(o)).unwrap_or(g))
+                .map(|g| revealed.filter(|_| is_follower_wait(o)).unwrap_or(g))
         })
         .reduce(f64::min)
         .map_or(0.0, |g| g.max(0.0))

@@ -208,6 +208,13 @@ impl GapAcceptanceSet {
     }
 }
 
+/// Whether `onset` is a start read as a wait for the follower
+/// (`observed::waited_for_the_follower`): the headway it started at and the
+/// follower's gap it waited for are both recorded.
+fn is_follower_wait(onset: &Onset) -> bool {
+    onset.follower_wait_time_headway_s.is_some() && onset.lag_time_gap_s.is_some()
+}
+
 /// The scene `onset` recorded and the step of it at which the driver started;
 /// `None` without a scene, for a mean of several starts ([`Onset::merged`]: a
 /// mean of starts is not a step at which the driver started), and for a start
